@@ -1,0 +1,60 @@
+#include "core/file_util.h"
+
+#include <algorithm>
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <unistd.h>
+
+#include "core/errors.h"
+
+namespace fs = std::filesystem;
+
+namespace raysift {
+
+std::string file_extension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
+}
+
+void require_readable_file(const std::string& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw IoError(file_message(path, "no such file"));
+  if (fs::is_directory(path, ec)) throw IoError(file_message(path, "is a directory, expected a file"));
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(file_message(path, "cannot be opened for reading (check permissions)"));
+}
+
+std::string read_file_bytes(const std::string& path) {
+  require_readable_file(path);
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  if (in.bad()) throw IoError(file_message(path, "read error"));
+  return s.str();
+}
+
+void write_atomically(const std::string& path, const std::function<void(const std::string&)>& write) {
+  static std::atomic<unsigned> counter{0};
+  const fs::path target(path);
+  std::error_code ec;
+  if (target.filename().empty() || fs::is_directory(target, ec))
+    throw IoError(file_message(path, "is a directory, expected an output file name"));
+  const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  if (!fs::is_directory(parent, ec))
+    throw IoError(file_message(path, "output folder '" + parent.string() + "' does not exist"));
+  const fs::path tmp = parent / ("." + target.stem().string() + ".tmp" + std::to_string(::getpid()) + "_" +
+                                 std::to_string(counter++) + target.extension().string());
+  try {
+    write(tmp.string());
+    fs::rename(tmp, target, ec);
+    if (ec) throw IoError(file_message(path, "cannot move finished output into place: " + ec.message()));
+  } catch (...) {
+    fs::remove(tmp, ec);
+    throw;
+  }
+}
+
+}  // namespace raysift

@@ -1,0 +1,147 @@
+#include "volume/volume.h"
+
+#include <openvdb/tools/Count.h>
+#include <openvdb/tools/Interpolation.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
+#include <mutex>
+
+#include "core/errors.h"
+#include "volume/detail/vdb_grid.h"
+
+namespace raysift::volume {
+
+namespace detail {
+void ensure_openvdb_initialized() {
+  static std::once_flag once;
+  std::call_once(once, [] { openvdb::initialize(); });
+}
+}  // namespace detail
+
+namespace {
+openvdb::math::Transform::Ptr scaled_transform(const Vec3d& voxel_size) {
+  openvdb::math::Mat4d m = openvdb::math::Mat4d::identity();
+  m.preScale(openvdb::Vec3d(voxel_size.x, voxel_size.y, voxel_size.z));
+  return openvdb::math::Transform::createLinearTransform(m);
+}
+
+std::shared_ptr<Volume::Impl> empty_impl() {
+  detail::ensure_openvdb_initialized();
+  auto impl = std::make_shared<Volume::Impl>();
+  impl->grid = openvdb::FloatGrid::create(0.0f);
+  impl->grid->setName("density");
+  return impl;
+}
+}  // namespace
+
+Volume::Volume() : impl_(empty_impl()) {}
+Volume::Volume(std::shared_ptr<Impl> impl) : impl_(std::move(impl)) { RAYSIFT_CHECK(impl_ && impl_->grid); }
+
+Volume Volume::from_function(const DenseSpec& spec, const std::function<float(int, int, int)>& value,
+                             const std::string& name) {
+  if (spec.dims.x <= 0 || spec.dims.y <= 0 || spec.dims.z <= 0)
+    throw InvalidInput("volume dims must be positive, got " + std::to_string(spec.dims.x) + "x" +
+                       std::to_string(spec.dims.y) + "x" + std::to_string(spec.dims.z));
+  if (!(spec.voxel_size.x > 0 && spec.voxel_size.y > 0 && spec.voxel_size.z > 0) || !is_finite(spec.voxel_size))
+    throw InvalidInput("voxel size must be positive and finite");
+  detail::ensure_openvdb_initialized();
+  using Tree = openvdb::FloatTree;
+  // Each z-slab builds its own tree, merged afterwards: deterministic and lock-free.
+  auto build = [&](const tbb::blocked_range<int>& r, Tree::Ptr tree) {
+    openvdb::tree::ValueAccessor<Tree> acc(*tree);
+    for (int k = r.begin(); k < r.end(); ++k)
+      for (int j = 0; j < spec.dims.y; ++j)
+        for (int i = 0; i < spec.dims.x; ++i) {
+          const float v = value(i, j, k);
+          if (!(std::abs(v - spec.background) <= spec.tolerance)) acc.setValueOn(openvdb::Coord(i, j, k), v);
+        }
+    return tree;
+  };
+  Tree::Ptr tree = tbb::parallel_reduce(
+      tbb::blocked_range<int>(0, spec.dims.z, 8), Tree::Ptr(),
+      [&](const tbb::blocked_range<int>& r, Tree::Ptr acc) {
+        if (!acc) acc = std::make_shared<Tree>(spec.background);
+        return build(r, acc);
+      },
+      [](Tree::Ptr a, Tree::Ptr b) {
+        if (!a) return b;
+        if (b) a->merge(*b, openvdb::MERGE_ACTIVE_STATES);
+        return a;
+      });
+  if (!tree) tree = std::make_shared<Tree>(spec.background);
+  auto impl = std::make_shared<Impl>();
+  impl->grid = openvdb::FloatGrid::create(tree);
+  impl->grid->setName(name);
+  impl->grid->setGridClass(openvdb::GRID_FOG_VOLUME);
+  const bool uniform = spec.voxel_size.x == spec.voxel_size.y && spec.voxel_size.y == spec.voxel_size.z;
+  openvdb::math::Transform::Ptr xform =
+      uniform ? openvdb::math::Transform::createLinearTransform(spec.voxel_size.x)
+              : scaled_transform(spec.voxel_size);
+  xform->postTranslate(openvdb::Vec3d(spec.origin_ws.x, spec.origin_ws.y, spec.origin_ws.z));
+  impl->grid->setTransform(xform);
+  return Volume(impl);
+}
+
+std::string Volume::name() const { return impl_->grid->getName(); }
+
+bool Volume::is_empty() const { return impl_->grid->tree().activeVoxelCount() == 0; }
+std::uint64_t Volume::active_voxel_count() const { return impl_->grid->tree().activeVoxelCount(); }
+
+Vec3d Volume::voxel_size() const {
+  const openvdb::Vec3d v = impl_->grid->voxelSize();
+  return {v.x(), v.y(), v.z()};
+}
+
+float Volume::background() const { return impl_->grid->background(); }
+
+GridInfo Volume::info() const {
+  const openvdb::FloatGrid& g = *impl_->grid;
+  GridInfo info;
+  info.name = g.getName();
+  info.type = g.valueType();
+  const auto cls = g.getGridClass();
+  info.grid_class = cls == openvdb::GRID_LEVEL_SET ? "level set" : cls == openvdb::GRID_FOG_VOLUME ? "fog volume" : "unknown";
+  info.active_voxels = g.tree().activeVoxelCount();
+  info.voxel_size = voxel_size();
+  info.background = g.background();
+  if (info.active_voxels == 0) return info;
+  const openvdb::CoordBBox box = g.evalActiveVoxelBoundingBox();
+  info.index_min = {box.min().x(), box.min().y(), box.min().z()};
+  info.index_max = {box.max().x(), box.max().y(), box.max().z()};
+  // World bbox of the eight transformed corners (handles any linear transform).
+  Bbox3d world;
+  for (int c = 0; c < 8; ++c) {
+    const openvdb::Vec3d p((c & 1) ? box.max().x() : box.min().x(), (c & 2) ? box.max().y() : box.min().y(),
+                           (c & 4) ? box.max().z() : box.min().z());
+    const openvdb::Vec3d w = g.indexToWorld(p);
+    world.expand({w.x(), w.y(), w.z()});
+  }
+  info.bbox_min = world.min;
+  info.bbox_max = world.max;
+  const openvdb::math::MinMax<float> range = openvdb::tools::minMax(g.tree());
+  info.value_min = range.min();
+  info.value_max = range.max();
+  return info;
+}
+
+float Volume::sample_index(const Vec3d& p_is) const {
+  openvdb::tools::GridSampler<openvdb::FloatGrid, openvdb::tools::BoxSampler> sampler(*impl_->grid);
+  return sampler.isSample(openvdb::Vec3d(p_is.x, p_is.y, p_is.z));
+}
+
+float Volume::value_at(const Vec3i& ijk) const {
+  return impl_->grid->tree().getValue(openvdb::Coord(ijk.x, ijk.y, ijk.z));
+}
+
+Vec3d Volume::index_to_world(const Vec3d& p_is) const {
+  const openvdb::Vec3d w = impl_->grid->indexToWorld(openvdb::Vec3d(p_is.x, p_is.y, p_is.z));
+  return {w.x(), w.y(), w.z()};
+}
+
+Vec3d Volume::world_to_index(const Vec3d& p_ws) const {
+  const openvdb::Vec3d i = impl_->grid->worldToIndex(openvdb::Vec3d(p_ws.x, p_ws.y, p_ws.z));
+  return {i.x(), i.y(), i.z()};
+}
+
+}  // namespace raysift::volume
