@@ -31,6 +31,8 @@ void write_pixels(const std::string& path, int width, int height, int channels, 
     OIIO::ImageSpec spec(width, height, channels, type);
     if (!names.empty()) spec.channelnames = names;
     if (type == OIIO::TypeDesc::FLOAT) spec.attribute("compression", "zip");
+    // Our colours are final display values: store them as given, never un-premultiplied by alpha.
+    spec.attribute("oiio:UnassociatedAlpha", 1);
     if (!out->open(tmp, spec)) throw IoError(file_message(path, "cannot open for writing: " + out->geterror()));
     if (!out->write_image(type, data) || !out->close())
       throw IoError(file_message(path, "write failed: " + out->geterror()));
@@ -46,7 +48,9 @@ struct RawImage {
 
 RawImage read_raw(const std::string& path) {
   require_readable_file(path);
-  auto in = OIIO::ImageInput::open(path);
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);  // read colours as stored (see write_pixels)
+  auto in = OIIO::ImageInput::open(path, &config);
   if (!in) throw IoError(file_message(path, "not a readable image: " + OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();
   RawImage img;
