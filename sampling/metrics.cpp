@@ -1,0 +1,445 @@
+// Image metrics. FLIP follows the LDR pipeline of NVlabs/flip (FLIP.h, separable filters) as written up
+// in ALGORITHMS.md section 7.3; it is an independent implementation, not a copy.
+#include "sampling/metrics.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace raysift::sampling {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+bool selected(const ImageMask* mask, std::size_t i) { return mask == nullptr || mask->pixels[i] != 0; }
+
+void require_same_size(const ImageRGBA& a, const ImageRGBA& b, const ImageMask* mask) {
+  if (a.width != b.width || a.height != b.height)
+    throw InvalidInput("image sizes differ: " + std::to_string(a.width) + "x" + std::to_string(a.height) + " vs " +
+                       std::to_string(b.width) + "x" + std::to_string(b.height) + "; compare images of the same view");
+  if (mask != nullptr && (mask->width != a.width || mask->height != a.height))
+    throw InvalidInput("mask size " + std::to_string(mask->width) + "x" + std::to_string(mask->height) +
+                       " differs from the image size " + std::to_string(a.width) + "x" + std::to_string(a.height));
+}
+
+void require_finite(const ImageRGBA& image, const char* which) {
+  for (std::size_t i = 0; i < image.size(); ++i) {
+    const Rgba& p = image.pixels[i];
+    if (!std::isfinite(p.r) || !std::isfinite(p.g) || !std::isfinite(p.b) || !std::isfinite(p.a))
+      throw InvalidInput(std::string(which) + " image has a NaN/Inf value at pixel (" +
+                         std::to_string(i % std::size_t(image.width)) + "," +
+                         std::to_string(i / std::size_t(image.width)) + ")");
+  }
+}
+
+std::array<float, 3> display_rgb(const Rgba& p) {
+  return {linear_to_srgb(p.r), linear_to_srgb(p.g), linear_to_srgb(p.b)};
+}
+
+// ---- FLIP colour spaces (linear sRGB primaries, D65) ----
+using Mat3 = std::array<std::array<double, 3>, 3>;
+using Col3 = std::array<float, 3>;
+
+constexpr Mat3 kRgbToXyz = {{{10135552.0 / 24577794.0, 8788810.0 / 24577794.0, 4435075.0 / 24577794.0},
+                             {2613072.0 / 12288897.0, 8788810.0 / 12288897.0, 887015.0 / 12288897.0},
+                             {1425312.0 / 73733382.0, 8788810.0 / 73733382.0, 70074185.0 / 73733382.0}}};
+
+Mat3 inverse(const Mat3& m) {
+  const double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+                     m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                     m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+  Mat3 r{};
+  r[0][0] = (m[1][1] * m[2][2] - m[1][2] * m[2][1]) / det;
+  r[0][1] = (m[0][2] * m[2][1] - m[0][1] * m[2][2]) / det;
+  r[0][2] = (m[0][1] * m[1][2] - m[0][2] * m[1][1]) / det;
+  r[1][0] = (m[1][2] * m[2][0] - m[1][0] * m[2][2]) / det;
+  r[1][1] = (m[0][0] * m[2][2] - m[0][2] * m[2][0]) / det;
+  r[1][2] = (m[0][2] * m[1][0] - m[0][0] * m[1][2]) / det;
+  r[2][0] = (m[1][0] * m[2][1] - m[1][1] * m[2][0]) / det;
+  r[2][1] = (m[0][1] * m[2][0] - m[0][0] * m[2][1]) / det;
+  r[2][2] = (m[0][0] * m[1][1] - m[0][1] * m[1][0]) / det;
+  return r;
+}
+
+struct FlipColour {
+  std::array<std::array<float, 3>, 3> to_xyz{}, to_rgb{};
+  Col3 white{};  // XYZ of linear white (1,1,1): the reference illuminant
+
+  FlipColour() {
+    const Mat3 inv = inverse(kRgbToXyz);
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        to_xyz[i][j] = float(kRgbToXyz[i][j]);
+        to_rgb[i][j] = float(inv[i][j]);
+      }
+      white[i] = float(kRgbToXyz[i][0] + kRgbToXyz[i][1] + kRgbToXyz[i][2]);
+    }
+  }
+  static Col3 apply(const std::array<std::array<float, 3>, 3>& m, const Col3& v) {
+    return {m[0][0] * v[0] + m[0][1] * v[1] + m[0][2] * v[2], m[1][0] * v[0] + m[1][1] * v[1] + m[1][2] * v[2],
+            m[2][0] * v[0] + m[2][1] * v[1] + m[2][2] * v[2]};
+  }
+  Col3 rgb_to_ycxcz(const Col3& rgb) const {
+    const Col3 xyz = apply(to_xyz, rgb);
+    const float x = xyz[0] / white[0], y = xyz[1] / white[1], z = xyz[2] / white[2];
+    return {116.0f * y - 16.0f, 500.0f * (x - y), 200.0f * (y - z)};
+  }
+  Col3 ycxcz_to_rgb(const Col3& c) const {
+    const float y = (c[0] + 16.0f) / 116.0f;
+    const Col3 xyz = {(y + c[1] / 500.0f) * white[0], y * white[1], (y - c[2] / 200.0f) * white[2]};
+    return apply(to_rgb, xyz);
+  }
+  Col3 rgb_to_lab(const Col3& rgb) const {
+    const Col3 xyz = apply(to_xyz, rgb);
+    constexpr float delta = 6.0f / 29.0f;
+    auto f = [&](float t) {
+      return t > delta * delta * delta ? std::cbrt(t) : t / (3.0f * delta * delta) + 4.0f / 29.0f;
+    };
+    const float fx = f(xyz[0] / white[0]), fy = f(xyz[1] / white[1]), fz = f(xyz[2] / white[2]);
+    return {116.0f * fy - 16.0f, 500.0f * (fx - fy), 200.0f * (fy - fz)};
+  }
+  // Hunt-adjusted Lab: chroma scaled by 0.01 L*.
+  Col3 hunt_lab(const Col3& rgb) const {
+    Col3 lab = rgb_to_lab(rgb);
+    lab[1] *= 0.01f * lab[0];
+    lab[2] *= 0.01f * lab[0];
+    return lab;
+  }
+};
+
+float hyab(const Col3& a, const Col3& b) {
+  return std::fabs(a[0] - b[0]) + std::sqrt((a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+constexpr float kGqc = 0.7f, kGpc = 0.4f, kGpt = 0.95f, kGw = 0.082f, kGqf = 0.5f;
+
+// CSF kernel g(x) = a sqrt(pi/b) exp(-pi^2 x^2 / b), x in degrees.
+float csf(float x_deg, float a, float b) {
+  return a * std::sqrt(float(kPi) / b) * std::exp(-float(kPi * kPi) * x_deg * x_deg / b);
+}
+
+// Runs fn(x, y) for every pixel, rows in parallel; each call writes only its own pixel.
+template <typename Fn>
+void for_each_pixel(int w, int h, Fn&& fn) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y < rows.end(); ++y)
+      for (int x = 0; x < w; ++x) fn(x, y);
+  });
+}
+
+}  // namespace
+
+double default_flip_ppd() { return 0.7 * (3840.0 / 0.7) * kPi / 180.0; }
+
+ImageMask object_mask_from_alpha(const ImageRGBA& reference) {
+  ImageMask mask(reference.width, reference.height, 0);
+  for (std::size_t i = 0; i < reference.size(); ++i) mask.pixels[i] = reference.pixels[i].a > 0.0f ? 1 : 0;
+  return mask;
+}
+
+double psnr(const ImageRGBA& a, const ImageRGBA& b, const ImageMask* mask) {
+  require_same_size(a, b, mask);
+  double sum = 0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (!selected(mask, i)) continue;
+    const auto pa = display_rgb(a.pixels[i]), pb = display_rgb(b.pixels[i]);
+    for (int c = 0; c < 3; ++c) sum += double(pa[c] - pb[c]) * double(pa[c] - pb[c]);
+    n += 3;
+  }
+  if (n == 0) return kPsnrCapDb;
+  const double mse = sum / double(n);
+  if (mse <= 0) return kPsnrCapDb;
+  return std::min(kPsnrCapDb, 10.0 * std::log10(1.0 / mse));
+}
+
+double mean_absolute_error(const ImageRGBA& a, const ImageRGBA& b, const ImageMask* mask) {
+  require_same_size(a, b, mask);
+  double sum = 0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (!selected(mask, i)) continue;
+    const auto pa = display_rgb(a.pixels[i]), pb = display_rgb(b.pixels[i]);
+    for (int c = 0; c < 3; ++c) sum += std::fabs(double(pa[c]) - double(pb[c]));
+    n += 3;
+  }
+  return n == 0 ? 0.0 : sum / double(n);
+}
+
+ImageF ssim_map(const ImageRGBA& a, const ImageRGBA& b) {
+  require_same_size(a, b, nullptr);
+  constexpr int kRadius = 5;
+  constexpr double kSigma = 1.5, kC1 = (0.01 * 255) * (0.01 * 255), kC2 = (0.03 * 255) * (0.03 * 255);
+  const int w = a.width, h = a.height;
+  ImageF out(w, h, std::numeric_limits<float>::quiet_NaN());
+  if (w < 2 * kRadius + 1 || h < 2 * kRadius + 1) return out;
+
+  std::array<double, 2 * kRadius + 1> weights{};
+  double weight_sum = 0;
+  for (int i = -kRadius; i <= kRadius; ++i) weight_sum += weights[i + kRadius] = std::exp(-i * i / (2 * kSigma * kSigma));
+  for (double& v : weights) v /= weight_sum;  // the 2D window is the outer product, so it also sums to 1
+
+  auto luma = [](const Rgba& p) {
+    const auto s = display_rgb(p);
+    return 255.0 * (0.299 * s[0] + 0.587 * s[1] + 0.114 * s[2]);
+  };
+  std::vector<double> ya(a.size()), yb(a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ya[i] = luma(a.pixels[i]);
+    yb[i] = luma(b.pixels[i]);
+  }
+  // Horizontal pass: five moments (x, y, x^2, y^2, xy) for the columns with a full window.
+  const int vw = w - 2 * kRadius;
+  std::vector<std::array<double, 5>> horizontal(std::size_t(vw) * std::size_t(h));
+  tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y < rows.end(); ++y)
+      for (int x = 0; x < vw; ++x) {
+        std::array<double, 5> m{};
+        for (int k = 0; k <= 2 * kRadius; ++k) {
+          const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x + k);
+          const double wk = weights[k], va = ya[i], vb = yb[i];
+          m[0] += wk * va;
+          m[1] += wk * vb;
+          m[2] += wk * va * va;
+          m[3] += wk * vb * vb;
+          m[4] += wk * va * vb;
+        }
+        horizontal[std::size_t(y) * std::size_t(vw) + std::size_t(x)] = m;
+      }
+  });
+  tbb::parallel_for(tbb::blocked_range<int>(kRadius, h - kRadius), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y < rows.end(); ++y)
+      for (int x = 0; x < vw; ++x) {
+        std::array<double, 5> m{};
+        for (int k = 0; k <= 2 * kRadius; ++k) {
+          const auto& hm = horizontal[std::size_t(y - kRadius + k) * std::size_t(vw) + std::size_t(x)];
+          for (int c = 0; c < 5; ++c) m[c] += weights[k] * hm[c];
+        }
+        const double mu_a = m[0], mu_b = m[1];
+        const double var_a = m[2] - mu_a * mu_a, var_b = m[3] - mu_b * mu_b, cov = m[4] - mu_a * mu_b;
+        const double s = ((2 * mu_a * mu_b + kC1) * (2 * cov + kC2)) /
+                         ((mu_a * mu_a + mu_b * mu_b + kC1) * (var_a + var_b + kC2));
+        out(x + kRadius, y) = float(s);
+      }
+  });
+  return out;
+}
+
+ImageF flip_map(const ImageRGBA& reference, const ImageRGBA& test, double ppd_in) {
+  require_same_size(reference, test, nullptr);
+  if (!(ppd_in > 0) || !std::isfinite(ppd_in)) throw InvalidInput("FLIP pixels per degree must be > 0");
+  const float ppd = float(ppd_in);
+  const int w = reference.width, h = reference.height;
+  const std::size_t n = reference.size();
+  static const FlipColour colour;
+
+  // Inputs as linear RGB clamped to [0,1], then YCxCz.
+  std::vector<Col3> ref_ycc(n), test_ycc(n);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& r) {
+    auto clamp01 = [](float v) { return std::min(1.0f, std::max(0.0f, v)); };
+    for (std::size_t i = r.begin(); i < r.end(); ++i) {
+      const Rgba& p = reference.pixels[i];
+      const Rgba& q = test.pixels[i];
+      ref_ycc[i] = colour.rgb_to_ycxcz({clamp01(p.r), clamp01(p.g), clamp01(p.b)});
+      test_ycc[i] = colour.rgb_to_ycxcz({clamp01(q.r), clamp01(q.g), clamp01(q.b)});
+    }
+  });
+
+  // Spatial CSF filters, separable. The blue-yellow filter is a sum of two Gaussians, so it runs as
+  // two separable filters with sqrt amplitudes whose 2D results are added.
+  constexpr float b_max = 0.04f;
+  const int sr = int(std::ceil(3.0f * std::sqrt(b_max / (2.0f * float(kPi * kPi))) * ppd));
+  const int sw = 2 * sr + 1;
+  std::vector<float> f_y(sw), f_cx(sw), f_cz1(sw), f_cz2(sw);
+  {
+    float sum_y = 0, sum_cx = 0, sum_cz1 = 0, sum_cz2 = 0;
+    for (int i = 0; i < sw; ++i) {
+      const float x = float(i - sr) / ppd;
+      sum_y += f_y[i] = csf(x, 1.0f, 0.0047f);
+      sum_cx += f_cx[i] = csf(x, 1.0f, 0.0053f);
+      sum_cz1 += f_cz1[i] = std::sqrt(34.1f * std::sqrt(float(kPi) / 0.04f)) *
+                            std::exp(-float(kPi * kPi) * x * x / 0.04f);
+      sum_cz2 += f_cz2[i] = std::sqrt(13.5f * std::sqrt(float(kPi) / 0.025f)) *
+                            std::exp(-float(kPi * kPi) * x * x / 0.025f);
+    }
+    const float norm_cz = 1.0f / std::sqrt(sum_cz1 * sum_cz1 + sum_cz2 * sum_cz2);
+    for (int i = 0; i < sw; ++i) {
+      f_y[i] /= sum_y;
+      f_cx[i] /= sum_cx;
+      f_cz1[i] *= norm_cz;
+      f_cz2[i] *= norm_cz;
+    }
+  }
+  // Intermediate per pixel: Y, Cx, Cz-part-1, Cz-part-2 for reference and test.
+  using Four = std::array<float, 4>;
+  std::vector<Four> ref_mid(n), test_mid(n);
+  for_each_pixel(w, h, [&, r = sr](int x, int y) {
+    Four mr{}, mt{};
+    for (int k = -r; k <= r; ++k) {
+      const int xx = std::min(std::max(0, x + k), w - 1);
+      const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(xx);
+      const int fi = k + r;
+      mr[0] += f_y[fi] * ref_ycc[i][0];
+      mr[1] += f_cx[fi] * ref_ycc[i][1];
+      mr[2] += f_cz1[fi] * ref_ycc[i][2];
+      mr[3] += f_cz2[fi] * ref_ycc[i][2];
+      mt[0] += f_y[fi] * test_ycc[i][0];
+      mt[1] += f_cx[fi] * test_ycc[i][1];
+      mt[2] += f_cz1[fi] * test_ycc[i][2];
+      mt[3] += f_cz2[fi] * test_ycc[i][2];
+    }
+    ref_mid[std::size_t(y) * std::size_t(w) + std::size_t(x)] = mr;
+    test_mid[std::size_t(y) * std::size_t(w) + std::size_t(x)] = mt;
+  });
+
+  Col3 green_lab = colour.hunt_lab({0, 1, 0}), blue_lab = colour.hunt_lab({0, 0, 1});
+  const float cmax = std::pow(hyab(green_lab, blue_lab), kGqc);
+  const float pccmax = kGpc * cmax;
+  std::vector<float> colour_error(n);
+  for_each_pixel(w, h, [&, r = sr](int x, int y) {
+    Four mr{}, mt{};
+    for (int k = -r; k <= r; ++k) {
+      const int yy = std::min(std::max(0, y + k), h - 1);
+      const std::size_t i = std::size_t(yy) * std::size_t(w) + std::size_t(x);
+      const int fi = k + r;
+      mr[0] += f_y[fi] * ref_mid[i][0];
+      mr[1] += f_cx[fi] * ref_mid[i][1];
+      mr[2] += f_cz1[fi] * ref_mid[i][2];
+      mr[3] += f_cz2[fi] * ref_mid[i][3];
+      mt[0] += f_y[fi] * test_mid[i][0];
+      mt[1] += f_cx[fi] * test_mid[i][1];
+      mt[2] += f_cz1[fi] * test_mid[i][2];
+      mt[3] += f_cz2[fi] * test_mid[i][3];
+    }
+    auto to_hunt_lab = [&](const Four& m) {
+      Col3 rgb = colour.ycxcz_to_rgb({m[0], m[1], m[2] + m[3]});
+      for (float& c : rgb) c = std::min(1.0f, std::max(0.0f, c));
+      return colour.hunt_lab(rgb);
+    };
+    float e = std::pow(hyab(to_hunt_lab(mr), to_hunt_lab(mt)), kGqc);
+    e = e < pccmax ? e * kGpt / pccmax : kGpt + (e - pccmax) / (cmax - pccmax) * (1.0f - kGpt);
+    colour_error[std::size_t(y) * std::size_t(w) + std::size_t(x)] = e;
+  });
+
+  // Edge and point detectors on the achromatic channel normalised to [0,1].
+  const float sigma = 0.5f * kGw * ppd;
+  const int fr = int(std::ceil(3.0f * sigma));
+  const int fw = 2 * fr + 1;
+  std::vector<float> g(fw), dg(fw), ddg(fw);
+  {
+    float g_sum = 0, dg_pos = 0, dg_neg = 0, ddg_pos = 0, ddg_neg = 0;
+    for (int i = 0; i < fw; ++i) {
+      const float x = float(i - fr);
+      g[i] = std::exp(-x * x / (2.0f * sigma * sigma));
+      g_sum += g[i];
+      dg[i] = -x * g[i];
+      (dg[i] > 0 ? dg_pos : dg_neg) += std::fabs(dg[i]);
+      ddg[i] = (x * x / (sigma * sigma) - 1.0f) * g[i];
+      (ddg[i] > 0 ? ddg_pos : ddg_neg) += std::fabs(ddg[i]);
+    }
+    // Gaussian sums to 1; positive and negative derivative weights sum to +1 and -1.
+    for (int i = 0; i < fw; ++i) {
+      g[i] /= g_sum;
+      dg[i] /= dg[i] > 0 ? dg_pos : dg_neg;
+      ddg[i] /= ddg[i] > 0 ? ddg_pos : ddg_neg;
+    }
+  }
+  using Three = std::array<float, 3>;  // d/dx, d2/dx2, Gaussian along x
+  std::vector<Three> ref_feat(n), test_feat(n);
+  for_each_pixel(w, h, [&, r = fr](int x, int y) {
+    Three fref{}, ft{};
+    for (int k = -r; k <= r; ++k) {
+      const int xx = std::min(std::max(0, x + k), w - 1);
+      const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(xx);
+      const int fi = k + r;
+      const float vr = (ref_ycc[i][0] + 16.0f) / 116.0f, vt = (test_ycc[i][0] + 16.0f) / 116.0f;
+      fref[0] += dg[fi] * vr;
+      fref[1] += ddg[fi] * vr;
+      fref[2] += g[fi] * vr;
+      ft[0] += dg[fi] * vt;
+      ft[1] += ddg[fi] * vt;
+      ft[2] += g[fi] * vt;
+    }
+    ref_feat[std::size_t(y) * std::size_t(w) + std::size_t(x)] = fref;
+    test_feat[std::size_t(y) * std::size_t(w) + std::size_t(x)] = ft;
+  });
+
+  ImageF out(w, h, 0.0f);
+  for_each_pixel(w, h, [&, r = fr](int x, int y) {
+    float dxr = 0, ddxr = 0, dyr = 0, ddyr = 0, dxt = 0, ddxt = 0, dyt = 0, ddyt = 0;
+    for (int k = -r; k <= r; ++k) {
+      const int yy = std::min(std::max(0, y + k), h - 1);
+      const std::size_t i = std::size_t(yy) * std::size_t(w) + std::size_t(x);
+      const int fi = k + r;
+      dxr += g[fi] * ref_feat[i][0];
+      ddxr += g[fi] * ref_feat[i][1];
+      dyr += dg[fi] * ref_feat[i][2];
+      ddyr += ddg[fi] * ref_feat[i][2];
+      dxt += g[fi] * test_feat[i][0];
+      ddxt += g[fi] * test_feat[i][1];
+      dyt += dg[fi] * test_feat[i][2];
+      ddyt += ddg[fi] * test_feat[i][2];
+    }
+    const float edge = std::fabs(std::sqrt(dxr * dxr + dyr * dyr) - std::sqrt(dxt * dxt + dyt * dyt));
+    const float point = std::fabs(std::sqrt(ddxr * ddxr + ddyr * ddyr) - std::sqrt(ddxt * ddxt + ddyt * ddyt));
+    const float feature = std::pow(std::max(edge, point) / std::sqrt(2.0f), kGqf);
+    const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
+    out.pixels[i] = std::pow(colour_error[i], 1.0f - feature);
+  });
+  return out;
+}
+
+Comparison compare_images(const ImageRGBA& reference, const ImageRGBA& test, const ImageMask* object_mask,
+                          const CompareOptions& options) {
+  require_same_size(reference, test, object_mask);
+  if (reference.width < 11 || reference.height < 11)
+    throw InvalidInput("images of " + std::to_string(reference.width) + "x" + std::to_string(reference.height) +
+                       " are too small to compare: SSIM needs at least 11x11 pixels");
+  require_finite(reference, "reference");
+  require_finite(test, "test");
+  const ImageMask alpha_mask = object_mask == nullptr ? object_mask_from_alpha(reference) : ImageMask{};
+  const ImageMask& mask = object_mask == nullptr ? alpha_mask : *object_mask;
+
+  Comparison result;
+  result.flip_map = flip_map(reference, test, options.flip_ppd);
+  const ImageF ssim = ssim_map(reference, test);
+
+  // Means in double, serially, so the result does not depend on the thread count.
+  auto fill = [&](ImageMetrics& m, const ImageMask* sel) {
+    m.psnr = psnr(reference, test, sel);
+    m.mae = mean_absolute_error(reference, test, sel);
+    double flip_sum = 0, ssim_sum = 0;
+    std::size_t count = 0, ssim_count = 0;
+    for (std::size_t i = 0; i < reference.size(); ++i) {
+      if (!selected(sel, i)) continue;
+      flip_sum += result.flip_map.pixels[i];
+      ++count;
+      if (!std::isnan(ssim.pixels[i])) {
+        ssim_sum += ssim.pixels[i];
+        ++ssim_count;
+      }
+    }
+    m.pixels = count;
+    m.flip = count ? flip_sum / double(count) : 0.0;
+    // An object entirely within the 5-pixel border has no full SSIM window: report 1 only if identical.
+    m.ssim = ssim_count ? ssim_sum / double(ssim_count) : (m.mae == 0 ? 1.0 : 0.0);
+  };
+  fill(result.frame, nullptr);
+  fill(result.object, &mask);
+  return result;
+}
+
+void add_metrics_json(Json& json, const ImageMetrics& metrics, const std::string& suffix) {
+  auto value = [&](double v) { return metrics.pixels == 0 ? Json(nullptr) : Json(v); };
+  json["psnr" + suffix] = value(metrics.psnr);
+  json["ssim" + suffix] = value(metrics.ssim);
+  json["mae" + suffix] = value(metrics.mae);
+  json["flip" + suffix] = value(metrics.flip);
+}
+
+}  // namespace raysift::sampling
