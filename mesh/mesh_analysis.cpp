@@ -1,0 +1,174 @@
+#include "mesh/mesh_analysis.h"
+
+#include <algorithm>
+#include <numeric>
+
+#include "core/errors.h"
+
+namespace raysift::mesh {
+
+namespace {
+
+using Tri = std::array<std::uint32_t, 3>;
+
+bool has_repeated_index(const Tri& t) { return t[0] == t[1] || t[1] == t[2] || t[0] == t[2]; }
+
+/// Union-find with path halving; union by smaller index keeps roots deterministic.
+class DisjointSets {
+ public:
+  explicit DisjointSets(std::size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), std::uint32_t(0)); }
+  std::uint32_t find(std::uint32_t x) {
+    while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
+    return x;
+  }
+  void unite(std::uint32_t a, std::uint32_t b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent_[std::max(a, b)] = std::min(a, b);
+  }
+
+ private:
+  std::vector<std::uint32_t> parent_;
+};
+
+/// Compressed vertex -> incident-triangle lists (CSR), triangles in increasing order per vertex.
+struct VertexFaces {
+  std::vector<std::uint32_t> offsets, faces;
+  VertexFaces(const TriMesh& mesh) : offsets(mesh.vertex_count() + 1, 0) {
+    for (const Tri& t : mesh.triangles)
+      for (const std::uint32_t v : t) ++offsets[v + 1];
+    std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+    faces.resize(offsets.back());
+    std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
+    for (std::uint32_t f = 0; f < mesh.triangles.size(); ++f)
+      for (const std::uint32_t v : mesh.triangles[f]) faces[fill[v]++] = f;
+  }
+};
+
+}  // namespace
+
+MeshAnalysis analyze_mesh(const TriMesh& mesh) {
+  MeshAnalysis a;
+  a.vertices = mesh.vertex_count();
+  a.faces = mesh.triangle_count();
+  const VertexFaces vf(mesh);
+
+  std::size_t used_vertices = 0;
+  for (std::size_t v = 0; v < a.vertices; ++v) {
+    if (vf.offsets[v] == vf.offsets[v + 1]) {
+      ++a.isolated_vertices;
+      continue;
+    }
+    ++used_vertices;
+    a.bbox.expand(Vec3d(mesh.positions[v]));
+  }
+
+  for (const Tri& t : mesh.triangles) {
+    const Vec3d p0(mesh.positions[t[0]]), p1(mesh.positions[t[1]]), p2(mesh.positions[t[2]]);
+    const Vec3d c = cross(p1 - p0, p2 - p0);
+    const double area = 0.5 * length(c);
+    a.area += area;
+    a.signed_volume += dot(p0, cross(p1, p2)) / 6.0;
+    if (has_repeated_index(t) || area == 0.0) ++a.degenerate_faces;
+  }
+
+  // Edges: for every vertex v, the sides (v, w) with w > v among its incident triangles. Each side
+  // records its direction (+1 if the triangle runs v -> w) so orientation consistency can be checked.
+  struct Side {
+    std::uint32_t other;
+    int direction;
+  };
+  std::vector<Side> sides;
+  std::vector<std::uint32_t> fan_parent;
+  for (std::uint32_t v = 0; v < a.vertices; ++v) {
+    sides.clear();
+    const std::uint32_t begin = vf.offsets[v], end = vf.offsets[v + 1];
+    for (std::uint32_t i = begin; i < end; ++i) {
+      const Tri& t = mesh.triangles[vf.faces[i]];
+      if (has_repeated_index(t)) continue;
+      const int k = t[0] == v ? 0 : (t[1] == v ? 1 : 2);
+      const std::uint32_t next = t[(k + 1) % 3], prev = t[(k + 2) % 3];
+      if (next > v) sides.push_back({next, +1});
+      if (prev > v) sides.push_back({prev, -1});
+    }
+    std::sort(sides.begin(), sides.end(), [](const Side& x, const Side& y) { return x.other < y.other; });
+    for (std::size_t i = 0; i < sides.size();) {
+      std::size_t j = i;
+      int direction_sum = 0;
+      while (j < sides.size() && sides[j].other == sides[i].other) direction_sum += sides[j++].direction;
+      const std::size_t count = j - i;
+      ++a.edges;
+      if (count == 1) ++a.boundary_edges;
+      if (count > 2) ++a.non_manifold_edges;
+      if (count == 2 && direction_sum != 0) ++a.inconsistent_edges;
+      i = j;
+    }
+
+    // Fans around v: incident non-degenerate triangles are linked when they share a second vertex.
+    const std::uint32_t n = end - begin;
+    fan_parent.resize(n);
+    std::iota(fan_parent.begin(), fan_parent.end(), 0u);
+    auto find = [&](std::uint32_t x) {
+      while (fan_parent[x] != x) x = fan_parent[x] = fan_parent[fan_parent[x]];
+      return x;
+    };
+    std::size_t valid = 0;
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const Tri& ti = mesh.triangles[vf.faces[begin + i]];
+      if (has_repeated_index(ti)) continue;
+      ++valid;
+      for (std::uint32_t j = 0; j < i; ++j) {
+        const Tri& tj = mesh.triangles[vf.faces[begin + j]];
+        if (has_repeated_index(tj)) continue;
+        for (const std::uint32_t w : ti)
+          if (w != v && (w == tj[0] || w == tj[1] || w == tj[2])) fan_parent[find(i)] = find(j);
+      }
+    }
+    std::size_t fans = 0;
+    for (std::uint32_t i = 0; i < n; ++i)
+      if (!has_repeated_index(mesh.triangles[vf.faces[begin + i]]) && find(i) == i) ++fans;
+    if (valid > 0 && fans > 1) ++a.non_manifold_vertices;
+  }
+
+  a.components = label_components(mesh).count;
+  a.euler_characteristic = std::int64_t(used_vertices) - std::int64_t(a.edges) + std::int64_t(a.faces);
+  return a;
+}
+
+ComponentLabels label_components(const TriMesh& mesh) {
+  DisjointSets sets(mesh.vertex_count());
+  for (const Tri& t : mesh.triangles) {
+    sets.unite(t[0], t[1]);
+    sets.unite(t[1], t[2]);
+  }
+  ComponentLabels labels;
+  labels.face_component.resize(mesh.triangle_count());
+  std::vector<std::uint32_t> label_of_root(mesh.vertex_count(), UINT32_MAX);
+  for (std::size_t f = 0; f < mesh.triangle_count(); ++f) {
+    std::uint32_t& label = label_of_root[sets.find(mesh.triangles[f][0])];
+    if (label == UINT32_MAX) label = std::uint32_t(labels.count++);
+    labels.face_component[f] = label;
+  }
+  return labels;
+}
+
+TriMesh extract_component(const TriMesh& mesh, const ComponentLabels& labels, std::size_t component) {
+  RAYSIFT_CHECK_OP(component, <, labels.count);
+  TriMesh out;
+  std::vector<std::uint32_t> new_index(mesh.vertex_count(), UINT32_MAX);
+  for (std::size_t f = 0; f < mesh.triangle_count(); ++f) {
+    if (labels.face_component[f] != component) continue;
+    Tri t = mesh.triangles[f];
+    for (std::uint32_t& v : t) {
+      if (new_index[v] == UINT32_MAX) {
+        new_index[v] = std::uint32_t(out.positions.size());
+        out.positions.push_back(mesh.positions[v]);
+      }
+      v = new_index[v];
+    }
+    out.triangles.push_back(t);
+  }
+  return out;
+}
+
+}  // namespace raysift::mesh
