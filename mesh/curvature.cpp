@@ -1,0 +1,451 @@
+#include "mesh/curvature.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "core/errors.h"
+#include "core/span.h"
+
+namespace raysift::mesh {
+namespace {
+
+using Tensor = std::array<double, 3>;   // (e, f, g): second fundamental form in some (u, v) frame
+using DTensor = std::array<double, 4>;  // (C111, C112, C122, C222)
+
+template <typename F>
+void for_range(std::size_t n, bool threaded, const F& body) {
+  if (threaded) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
+    });
+  } else {
+    for (std::size_t i = 0; i < n; ++i) body(i);
+  }
+}
+
+/// Solves the symmetric system A x = b by LDLᵀ (A is a least-squares normal matrix). Returns false when a
+/// pivot is not clearly positive (relative to the largest diagonal entry): the face is then skipped, as
+/// trimesh2's ldltdc does.
+template <int N>
+bool solve_ldlt(double (&a)[N][N], const double (&b)[N], double (&x)[N]) {
+  double scale = 0;
+  for (int i = 0; i < N; ++i) scale = std::max(scale, std::abs(a[i][i]));
+  if (!(scale > 0)) return false;
+  double d[N];
+  double l[N][N] = {};
+  for (int i = 0; i < N; ++i) {
+    double sum = a[i][i];
+    for (int k = 0; k < i; ++k) sum -= l[i][k] * l[i][k] * d[k];
+    if (!(sum > 1e-12 * scale)) return false;
+    d[i] = sum;
+    for (int j = i + 1; j < N; ++j) {
+      double s = a[j][i];
+      for (int k = 0; k < i; ++k) s -= l[j][k] * l[i][k] * d[k];
+      l[j][i] = s / d[i];
+    }
+  }
+  double y[N];
+  for (int i = 0; i < N; ++i) {
+    y[i] = b[i];
+    for (int k = 0; k < i; ++k) y[i] -= l[i][k] * y[k];
+  }
+  for (int i = N - 1; i >= 0; --i) {
+    x[i] = y[i] / d[i];
+    for (int k = i + 1; k < N; ++k) x[i] -= l[k][i] * x[k];
+  }
+  return true;
+}
+
+/// Rotates the frame (old_u, old_v) rigidly about old_n × new_norm so its normal becomes new_norm
+/// (trimesh2 rot_coord_sys).
+void rotate_frame(const Vec3d& old_u, const Vec3d& old_v, const Vec3d& new_norm, Vec3d& new_u, Vec3d& new_v) {
+  new_u = old_u;
+  new_v = old_v;
+  const Vec3d old_norm = cross(old_u, old_v);
+  const double ndot = dot(old_norm, new_norm);
+  if (ndot <= -1.0) {
+    new_u = -new_u;
+    new_v = -new_v;
+    return;
+  }
+  const Vec3d perp_old = new_norm - old_norm * ndot;
+  const Vec3d dperp = (old_norm + new_norm) * (1.0 / (1.0 + ndot));
+  new_u -= dperp * dot(new_u, perp_old);
+  new_v -= dperp * dot(new_v, perp_old);
+}
+
+/// Re-expresses a curvature tensor given in (old_u, old_v) in the frame (new_u, new_v) (trimesh2 proj_curv).
+Tensor project_tensor(const Vec3d& old_u, const Vec3d& old_v, const Tensor& k, const Vec3d& new_u,
+                      const Vec3d& new_v) {
+  Vec3d ru, rv;
+  rotate_frame(new_u, new_v, cross(old_u, old_v), ru, rv);
+  const double u1 = dot(ru, old_u), v1 = dot(ru, old_v), u2 = dot(rv, old_u), v2 = dot(rv, old_v);
+  return {k[0] * u1 * u1 + k[1] * (2 * u1 * v1) + k[2] * v1 * v1,
+          k[0] * u1 * u2 + k[1] * (u1 * v2 + u2 * v1) + k[2] * v1 * v2,
+          k[0] * u2 * u2 + k[1] * (2 * u2 * v2) + k[2] * v2 * v2};
+}
+
+/// Cubic transformation rule C'(x,y,z) = C(Rx,Ry,Rz) for the derivative tensor (trimesh2 proj_dcurv).
+DTensor project_dtensor(const Vec3d& old_u, const Vec3d& old_v, const DTensor& c, const Vec3d& new_u,
+                        const Vec3d& new_v) {
+  Vec3d ru, rv;
+  rotate_frame(new_u, new_v, cross(old_u, old_v), ru, rv);
+  const double u1 = dot(ru, old_u), v1 = dot(ru, old_v), u2 = dot(rv, old_u), v2 = dot(rv, old_v);
+  return {c[0] * u1 * u1 * u1 + c[1] * 3 * u1 * u1 * v1 + c[2] * 3 * u1 * v1 * v1 + c[3] * v1 * v1 * v1,
+          c[0] * u1 * u1 * u2 + c[1] * (u1 * u1 * v2 + 2 * u2 * u1 * v1) + c[2] * (u2 * v1 * v1 + 2 * u1 * v1 * v2) +
+              c[3] * v1 * v1 * v2,
+          c[0] * u1 * u2 * u2 + c[1] * (u2 * u2 * v1 + 2 * u1 * u2 * v2) + c[2] * (u1 * v2 * v2 + 2 * u2 * v2 * v1) +
+              c[3] * v1 * v2 * v2,
+          c[0] * u2 * u2 * u2 + c[1] * 3 * u2 * u2 * v2 + c[2] * 3 * u2 * v2 * v2 + c[3] * v2 * v2 * v2};
+}
+
+/// Per-face data: (t, b) tangent frame, corner areas, and whether the face takes part in the fits.
+struct FaceFrame {
+  Vec3d t, b;
+  std::array<Vec3d, 3> edge;  // edge[j] is opposite corner j: p[j+2] - p[j+1]
+  std::array<double, 3> corner_area{};
+  bool is_degenerate = true;
+  bool is_fitted = false;     // non-degenerate and all three vertices valid
+};
+
+std::array<Vec3d, 3> face_points(const TriMesh& mesh, std::size_t f) {
+  const auto& t = mesh.triangles[f];
+  return {Vec3d(mesh.positions[t[0]]), Vec3d(mesh.positions[t[1]]), Vec3d(mesh.positions[t[2]])};
+}
+
+/// Mixed-Voronoi corner areas (trimesh2 TriMesh_pointareas.cc, including its obtuse-triangle split).
+std::array<double, 3> corner_areas(const std::array<Vec3d, 3>& e, double area) {
+  const double l2[3] = {dot(e[0], e[0]), dot(e[1], e[1]), dot(e[2], e[2])};
+  const double ew[3] = {l2[0] * (l2[1] + l2[2] - l2[0]), l2[1] * (l2[2] + l2[0] - l2[1]),
+                        l2[2] * (l2[0] + l2[1] - l2[2])};
+  std::array<double, 3> c{};
+  for (int o = 0; o < 3; ++o) {
+    if (ew[o] > 0) continue;
+    // Corner o is obtuse: each acute corner keeps its part of the Voronoi region inside the triangle.
+    const int a = (o + 1) % 3, b = (o + 2) % 3;
+    c[a] = -0.25 * l2[b] * area / dot(e[o], e[b]);
+    c[b] = -0.25 * l2[a] * area / dot(e[o], e[a]);
+    c[o] = area - c[a] - c[b];
+    return c;
+  }
+  const double s = 0.5 * area / (ew[0] + ew[1] + ew[2]);
+  for (int j = 0; j < 3; ++j) c[j] = s * (ew[(j + 1) % 3] + ew[(j + 2) % 3]);
+  return c;
+}
+
+/// Vertex -> incident (face, corner) list in face order (compressed rows), which makes every per-vertex
+/// gather deterministic.
+struct VertexFaces {
+  std::vector<std::uint32_t> offset;  // size nv + 1
+  std::vector<std::uint32_t> corner;  // face * 3 + corner
+  Span<const std::uint32_t> of(std::size_t v) const { return {corner.data() + offset[v], offset[v + 1] - offset[v]}; }
+};
+
+VertexFaces build_vertex_faces(const TriMesh& mesh) {
+  VertexFaces vf;
+  vf.offset.assign(mesh.vertex_count() + 1, 0);
+  for (const auto& t : mesh.triangles)
+    for (std::uint32_t v : t) ++vf.offset[v + 1];
+  for (std::size_t v = 0; v < mesh.vertex_count(); ++v) vf.offset[v + 1] += vf.offset[v];
+  vf.corner.resize(mesh.triangle_count() * 3);
+  std::vector<std::uint32_t> fill(vf.offset.begin(), vf.offset.end() - 1);
+  for (std::size_t f = 0; f < mesh.triangle_count(); ++f)
+    for (int j = 0; j < 3; ++j) vf.corner[fill[mesh.triangles[f][j]]++] = std::uint32_t(f * 3 + j);
+  return vf;
+}
+
+enum class VertexKind { Interior, Boundary, NonManifold, Isolated };
+
+/// Classifies a vertex from its link: each incident face (v, a, b) in CCW order contributes the link edge
+/// a -> b. A manifold vertex's link is one closed cycle (interior) or one open path (boundary).
+VertexKind classify_vertex(const TriMesh& mesh, Span<const std::uint32_t> corners,
+                           const std::vector<FaceFrame>& faces) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> link;
+  for (std::uint32_t c : corners) {
+    const std::size_t f = c / 3;
+    if (faces[f].is_degenerate) continue;
+    const auto& t = mesh.triangles[f];
+    link.emplace_back(t[(c % 3 + 1) % 3], t[(c % 3 + 2) % 3]);
+  }
+  if (link.empty()) return VertexKind::Isolated;
+  auto count = [&](std::uint32_t x, bool as_source) {
+    return std::count_if(link.begin(), link.end(), [&](const auto& e) { return (as_source ? e.first : e.second) == x; });
+  };
+  std::size_t start = 0;
+  int open_ends = 0;
+  for (std::size_t i = 0; i < link.size(); ++i) {
+    // A repeated source means an edge with more than two faces or inconsistent orientation.
+    if (count(link[i].first, true) != 1 || count(link[i].second, false) != 1) return VertexKind::NonManifold;
+    if (count(link[i].first, false) == 0) {
+      ++open_ends;
+      start = i;
+    }
+  }
+  if (open_ends > 1) return VertexKind::NonManifold;
+  std::size_t walked = 1;
+  for (std::size_t i = start; walked <= link.size(); ++walked) {
+    const auto next = std::find_if(link.begin(), link.end(), [&](const auto& e) { return e.first == link[i].second; });
+    if (next == link.end() || std::size_t(next - link.begin()) == start) break;
+    i = std::size_t(next - link.begin());
+  }
+  if (walked != link.size()) return VertexKind::NonManifold;  // several fans sharing the vertex
+  return open_ends == 1 ? VertexKind::Boundary : VertexKind::Interior;
+}
+
+void validate(const TriMesh& mesh) {
+  if (mesh.empty()) throw InvalidInput("curvature: the mesh has no triangles; nothing to compute");
+  for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+    if (!is_finite(mesh.positions[v]))
+      throw InvalidInput("curvature: vertex " + std::to_string(v) + " has a NaN or infinite coordinate; " +
+                         "Hint: repair or re-extract the mesh");
+  for (std::size_t f = 0; f < mesh.triangle_count(); ++f)
+    for (std::uint32_t v : mesh.triangles[f])
+      if (v >= mesh.vertex_count())
+        throw InvalidInput("curvature: triangle " + std::to_string(f) + " references vertex " + std::to_string(v) +
+                           " but the mesh has " + std::to_string(mesh.vertex_count()) + " vertices");
+}
+
+double compute_feature_size(const MeshCurvature& c, const TriMesh& mesh) {
+  std::vector<std::size_t> valid;
+  for (std::size_t v = 0; v < c.k1.size(); ++v)
+    if (c.is_valid[v]) valid.push_back(v);
+  Bbox3d box;
+  for (const Vec3f& p : mesh.positions) box.expand(Vec3d(p));
+  // [choice] bounding radius = half the bbox diagonal (rtsc uses trimesh2's bounding sphere).
+  const double max_size = 0.05 * 0.5 * box.diagonal();
+  if (valid.empty()) return max_size;
+  // rtsc samples 500 random vertices; a fixed stride keeps the result deterministic.
+  const std::size_t n = std::min<std::size_t>(valid.size(), 500);
+  std::vector<double> samples;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t v = valid[i * valid.size() / n];
+    samples.push_back(std::abs(c.k1[v]));
+    samples.push_back(std::abs(c.k2[v]));
+  }
+  const auto which = samples.begin() + std::ptrdiff_t(0.1 * double(samples.size()));
+  std::nth_element(samples.begin(), which, samples.end());
+  return *which > 0 ? std::min(0.01 / *which, max_size) : max_size;
+}
+
+}  // namespace
+
+MeshCurvature compute_curvature(const TriMesh& mesh, const CurvatureOptions& options) {
+  validate(mesh);
+  const std::size_t nv = mesh.vertex_count(), nf = mesh.triangle_count();
+  const bool threaded = options.threaded;
+  MeshCurvature out;
+
+  Bbox3d box;
+  for (const Vec3f& p : mesh.positions) box.expand(Vec3d(p));
+  // Relative to the squared bbox diagonal: below this a face's area is rounding noise.
+  const double min_area = 1e-14 * box.diagonal() * box.diagonal();
+
+  std::vector<FaceFrame> faces(nf);
+  for_range(nf, threaded, [&](std::size_t f) {
+    const auto p = face_points(mesh, f);
+    FaceFrame& ff = faces[f];
+    ff.edge = {p[2] - p[1], p[0] - p[2], p[1] - p[0]};
+    const Vec3d n = cross(ff.edge[0], ff.edge[1]);
+    const double area = 0.5 * length(n);
+    const auto& t = mesh.triangles[f];
+    if (!(area > min_area) || t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) return;
+    ff.is_degenerate = false;
+    ff.t = normalize(ff.edge[0]);
+    ff.b = normalize(cross(n, ff.t));
+    ff.corner_area = corner_areas(ff.edge, area);
+  });
+  for (const FaceFrame& ff : faces) out.degenerate_faces += ff.is_degenerate ? 1 : 0;
+
+  const VertexFaces vf = build_vertex_faces(mesh);
+  out.normals.assign(nv, Vec3f{});
+  out.point_areas.assign(nv, 0.0f);
+  out.is_valid.assign(nv, 0);
+  std::vector<VertexKind> kind(nv);
+  std::vector<Vec3d> normal(nv), u(nv), v(nv);
+  for_range(nv, threaded, [&](std::size_t vi) {
+    kind[vi] = classify_vertex(mesh, vf.of(vi), faces);
+    Vec3d n{};
+    double area = 0;
+    for (std::uint32_t c : vf.of(vi)) {
+      const FaceFrame& ff = faces[c / 3];
+      if (ff.is_degenerate) continue;
+      const int j = int(c % 3);
+      // Max (1999) weights: face normal over the squared lengths of the two edges at this corner.
+      const Vec3d& ea = ff.edge[(j + 1) % 3];
+      const Vec3d& eb = ff.edge[(j + 2) % 3];
+      n += cross(ff.edge[0], ff.edge[1]) * (1.0 / (dot(ea, ea) * dot(eb, eb)));
+      area += ff.corner_area[j];
+    }
+    normal[vi] = normalize(n);
+    out.point_areas[vi] = float(area);
+    const bool is_manifold = kind[vi] == VertexKind::Interior || kind[vi] == VertexKind::Boundary;
+    out.is_valid[vi] = (is_manifold && length(normal[vi]) > 0) ? 1 : 0;
+    out.normals[vi] = out.is_valid[vi] ? Vec3f(normal[vi]) : Vec3f{};
+  });
+  for (std::size_t vi = 0; vi < nv; ++vi) {
+    out.boundary_vertices += kind[vi] == VertexKind::Boundary ? 1 : 0;
+    out.nonmanifold_vertices += kind[vi] == VertexKind::NonManifold ? 1 : 0;
+    out.unreferenced_vertices += kind[vi] == VertexKind::Isolated ? 1 : 0;
+  }
+  for_range(nf, threaded, [&](std::size_t f) {
+    const auto& t = mesh.triangles[f];
+    faces[f].is_fitted = !faces[f].is_degenerate && out.is_valid[t[0]] && out.is_valid[t[1]] && out.is_valid[t[2]];
+  });
+
+  // Initial vertex frames: an incident edge made perpendicular to the normal (trimesh2).
+  for_range(nv, threaded, [&](std::size_t vi) {
+    for (std::uint32_t c : vf.of(vi)) {
+      if (!out.is_valid[vi] || faces[c / 3].is_degenerate) continue;
+      const Vec3d e = faces[c / 3].edge[(c % 3 + 2) % 3];  // from this corner to the next
+      u[vi] = normalize(cross(e, normal[vi]));
+      if (length(u[vi]) > 0) break;
+    }
+    v[vi] = cross(normal[vi], u[vi]);
+  });
+
+  // Second fundamental form per face from normal differences along the edges.
+  std::vector<Tensor> face_ii(nf);
+  for_range(nf, threaded, [&](std::size_t f) {
+    FaceFrame& ff = faces[f];
+    if (!ff.is_fitted) return;
+    const auto& tri = mesh.triangles[f];
+    double m[3] = {0, 0, 0};
+    double w[3][3] = {};
+    for (int j = 0; j < 3; ++j) {
+      const double eu = dot(ff.edge[j], ff.t), ev = dot(ff.edge[j], ff.b);
+      w[0][0] += eu * eu;
+      w[0][1] += eu * ev;
+      w[2][2] += ev * ev;
+      const Vec3d dn = normal[tri[(j + 2) % 3]] - normal[tri[(j + 1) % 3]];
+      const double dnu = dot(dn, ff.t), dnv = dot(dn, ff.b);
+      m[0] += dnu * eu;
+      m[1] += dnu * ev + dnv * eu;
+      m[2] += dnv * ev;
+    }
+    w[1][1] = w[0][0] + w[2][2];
+    w[1][2] = w[0][1];
+    w[1][0] = w[0][1];
+    w[2][1] = w[1][2];
+    double x[3];
+    if (!solve_ldlt<3>(w, m, x)) {
+      ff.is_fitted = false;
+      return;
+    }
+    face_ii[f] = {x[0], x[1], x[2]};
+  });
+
+  // Gather into vertex frames with corner-area weights, then diagonalise (one Jacobi rotation).
+  out.k1.assign(nv, 0.0f);
+  out.k2.assign(nv, 0.0f);
+  out.dir1.assign(nv, Vec3f{});
+  out.dir2.assign(nv, Vec3f{});
+  std::vector<Vec3d> d1(nv), d2(nv);
+  for_range(nv, threaded, [&](std::size_t vi) {
+    if (!out.is_valid[vi]) return;
+    Tensor k{0, 0, 0};
+    double weight = 0;
+    for (std::uint32_t c : vf.of(vi)) {
+      const FaceFrame& ff = faces[c / 3];
+      if (!ff.is_fitted) continue;
+      const double wt = ff.corner_area[c % 3];
+      const Tensor p = project_tensor(ff.t, ff.b, face_ii[c / 3], u[vi], v[vi]);
+      for (int i = 0; i < 3; ++i) k[i] += wt * p[i];
+      weight += wt;
+    }
+    // [choice] normalise by the weight actually used (trimesh2 divides by the full point area), so
+    // skipped neighbours do not shrink the curvature.
+    if (weight > 0)
+      for (double& x : k) x /= weight;
+    Vec3d ru, rv;
+    rotate_frame(u[vi], v[vi], normal[vi], ru, rv);
+    double c = 1, s = 0, tt = 0;
+    if (k[1] != 0) {
+      const double h = 0.5 * (k[2] - k[0]) / k[1];
+      tt = h < 0 ? 1 / (h - std::sqrt(1 + h * h)) : 1 / (h + std::sqrt(1 + h * h));
+      c = 1 / std::sqrt(1 + tt * tt);
+      s = tt * c;
+    }
+    double k1 = k[0] - tt * k[1], k2 = k[2] + tt * k[1];
+    if (std::abs(k1) >= std::abs(k2)) {
+      d1[vi] = ru * c - rv * s;
+    } else {
+      std::swap(k1, k2);
+      d1[vi] = ru * s + rv * c;
+    }
+    d2[vi] = cross(normal[vi], d1[vi]);
+    out.k1[vi] = float(k1);
+    out.k2[vi] = float(k2);
+    out.dir1[vi] = Vec3f(d1[vi]);
+    out.dir2[vi] = Vec3f(d2[vi]);
+  });
+
+  // Derivative tensor per face from curvature-tensor differences along the edges.
+  std::vector<DTensor> face_c(nf);
+  std::vector<std::uint8_t> has_c(nf, 0);
+  for_range(nf, threaded, [&](std::size_t f) {
+    const FaceFrame& ff = faces[f];
+    if (!ff.is_fitted) return;
+    const auto& tri = mesh.triangles[f];
+    Tensor fk[3];
+    for (int j = 0; j < 3; ++j) {
+      const std::uint32_t vj = tri[j];
+      fk[j] = project_tensor(d1[vj], d2[vj], {out.k1[vj], 0.0, out.k2[vj]}, ff.t, ff.b);
+    }
+    double m[4] = {0, 0, 0, 0};
+    double w[4][4] = {};
+    for (int j = 0; j < 3; ++j) {
+      const Tensor& ka = fk[(j + 2) % 3];
+      const Tensor& kb = fk[(j + 1) % 3];
+      const double df[3] = {ka[0] - kb[0], ka[1] - kb[1], ka[2] - kb[2]};
+      const double eu = dot(ff.edge[j], ff.t), ev = dot(ff.edge[j], ff.b);
+      w[0][0] += eu * eu;
+      w[0][1] += eu * ev;
+      w[3][3] += ev * ev;
+      // The off-diagonal f appears twice in the tensor, so its equation carries weight 2 (trimesh2).
+      m[0] += eu * df[0];
+      m[1] += ev * df[0] + 2 * eu * df[1];
+      m[2] += 2 * ev * df[1] + eu * df[2];
+      m[3] += ev * df[2];
+    }
+    w[1][1] = 2 * w[0][0] + w[3][3];
+    w[1][2] = 2 * w[0][1];
+    w[2][2] = w[0][0] + 2 * w[3][3];
+    w[2][3] = w[0][1];
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < i; ++j) w[i][j] = w[j][i];
+    double x[4];
+    if (!solve_ldlt<4>(w, m, x)) return;
+    face_c[f] = {x[0], x[1], x[2], x[3]};
+    has_c[f] = 1;
+  });
+  out.dcurv.assign(nv, {0, 0, 0, 0});
+  for_range(nv, threaded, [&](std::size_t vi) {
+    if (!out.is_valid[vi]) return;
+    DTensor sum{0, 0, 0, 0};
+    double weight = 0;
+    for (std::uint32_t c : vf.of(vi)) {
+      if (!has_c[c / 3]) continue;
+      const FaceFrame& ff = faces[c / 3];
+      const double wt = ff.corner_area[c % 3];
+      const DTensor p = project_dtensor(ff.t, ff.b, face_c[c / 3], d1[vi], d2[vi]);
+      for (int i = 0; i < 4; ++i) sum[i] += wt * p[i];
+      weight += wt;
+    }
+    for (int i = 0; i < 4; ++i) out.dcurv[vi][i] = weight > 0 ? float(sum[i] / weight) : 0.0f;
+  });
+
+  for (std::size_t vi = 0; vi < nv; ++vi) {
+    const auto& c = out.dcurv[vi];
+    if (!std::isfinite(out.k1[vi]) || !std::isfinite(out.k2[vi]) || !is_finite(out.dir1[vi]) ||
+        !std::isfinite(c[0] + c[1] + c[2] + c[3]))
+      throw SolverError("curvature: non-finite result at vertex " + std::to_string(vi));
+  }
+  out.feature_size = compute_feature_size(out, mesh);
+  return out;
+}
+
+}  // namespace raysift::mesh
