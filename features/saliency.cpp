@@ -1,0 +1,409 @@
+#include "features/saliency.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <sstream>
+#include <vector>
+
+#include "core/errors.h"
+
+namespace raysift::features {
+namespace {
+
+using Plane = ImageF;
+
+/// Classic Itti pyramid depth; shallower when the image runs out of pixels first.
+constexpr int kMaxLevels = 8;
+/// Centre levels and centre-surround level gaps, shifted down by one level from Itti's {2,3,4} because
+/// the input is already downscaled (ALGORITHMS.md §6.3). The conspicuity maps live at the finest centre.
+constexpr std::array<int, 3> kCentreLevels = {1, 2, 3};
+constexpr std::array<int, 2> kSurroundDeltas = {3, 4};
+constexpr int kConspicuityLevel = kCentreLevels[0];
+/// Absolute, CIELAB units (Delta E): a feature map whose largest centre-surround contrast is below half a
+/// just-noticeable difference (JND ~ 1 Delta E) holds no visible structure; treating it as empty also
+/// keeps float rounding in a uniform image from being blown up to full saliency by N(.).
+constexpr float kContrastFloorLab = 0.5f;
+/// Relative to the map maximum: local maxima below this share are ignored by N(.) ([choice], ALGORITHMS.md §6.1).
+constexpr float kLocalMaxThreshold = 0.1f;
+constexpr int kGaborRadius = 4;           // 9x9 kernel [choice]
+constexpr double kGaborWavelengthPx = 4;  // [choice]
+constexpr double kGaborSigmaPx = 2;       // [choice]
+constexpr int kOrientations = 4;          // 0, 45, 90, 135 degrees
+
+template <typename F>
+void for_rows(int height, bool threaded, const F& row) {
+  if (!threaded) {
+    for (int y = 0; y < height; ++y) row(y);
+    return;
+  }
+  tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& r) {
+    for (int y = r.begin(); y < r.end(); ++y) row(y);
+  });
+}
+
+template <typename F>
+void for_items(int count, bool threaded, const F& item) {
+  if (!threaded) {
+    for (int i = 0; i < count; ++i) item(i);
+    return;
+  }
+  tbb::parallel_for(tbb::blocked_range<int>(0, count, 1), [&](const tbb::blocked_range<int>& r) {
+    for (int i = r.begin(); i < r.end(); ++i) item(i);
+  });
+}
+
+void validate(const ImageRGBA& image, const SaliencyOptions& options) {
+  std::ostringstream why;
+  if (image.width <= 0 || image.height <= 0 || image.size() != std::size_t(image.width) * std::size_t(image.height)) {
+    why << "saliency: the image is empty (" << image.width << "x" << image.height << " pixels)";
+    throw InvalidInput(why.str());
+  }
+  if (!(options.scale > 0.0 && options.scale <= 1.0)) {
+    why << "saliency: scale must be in (0, 1], got " << options.scale;
+    throw InvalidInput(why.str());
+  }
+  const int w = saliency_map_side(image.width, options.scale);
+  const int h = saliency_map_side(image.height, options.scale);
+  if (std::min(w, h) < kSaliencyMinSide) {
+    why << "saliency: the downscaled frame is " << w << "x" << h << " pixels, but both sides must be at least "
+        << kSaliencyMinSide << "; use a larger scale or a larger image";
+    throw InvalidInput(why.str());
+  }
+  const auto is_bad = [](const Rgba& p) {
+    return !(std::isfinite(p.r) && std::isfinite(p.g) && std::isfinite(p.b));
+  };
+  const bool any_bad = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, image.size()), false,
+      [&](const tbb::blocked_range<std::size_t>& r, bool bad) {
+        for (std::size_t i = r.begin(); i < r.end() && !bad; ++i) bad = is_bad(image.pixels[i]);
+        return bad;
+      },
+      [](bool a, bool b) { return a || b; });
+  if (any_bad) {
+    const std::size_t i = std::size_t(std::find_if(image.pixels.begin(), image.pixels.end(), is_bad) -
+                                      image.pixels.begin());
+    why << "saliency: pixel (" << i % std::size_t(image.width) << "," << i / std::size_t(image.width)
+        << ") has a non-finite colour; the frame must hold finite linear RGB";
+    throw InvalidInput(why.str());
+  }
+}
+
+/// Box-filter weights of one axis: output pixel i averages input [i*n/m, (i+1)*n/m) by overlap.
+struct AxisTaps {
+  std::vector<int> first;       // first input index per output pixel
+  std::vector<int> offsets;     // start of each output pixel's weights in `weights`
+  std::vector<float> weights;
+};
+
+AxisTaps box_taps(int n_in, int n_out) {
+  AxisTaps taps;
+  const double step = double(n_in) / double(n_out);
+  for (int i = 0; i < n_out; ++i) {
+    const double lo = i * step, hi = (i + 1) * step;
+    const int first = int(std::floor(lo));
+    const int last = std::min(n_in - 1, int(std::ceil(hi)) - 1);
+    taps.first.push_back(first);
+    taps.offsets.push_back(int(taps.weights.size()));
+    for (int k = first; k <= last; ++k) {
+      const double overlap = std::min(hi, double(k + 1)) - std::max(lo, double(k));
+      taps.weights.push_back(float(overlap / step));
+    }
+  }
+  taps.offsets.push_back(int(taps.weights.size()));
+  return taps;
+}
+
+/// Downscaled linear RGB as three planes (box filter: the average of the covered input area).
+std::array<Plane, 3> downscale_rgb(const ImageRGBA& image, int w, int h, bool threaded) {
+  const AxisTaps tx = box_taps(image.width, w);
+  const AxisTaps ty = box_taps(image.height, h);
+  std::array<Plane, 3> horizontal;
+  for (Plane& p : horizontal) p = Plane(w, image.height);
+  for_rows(image.height, threaded, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      double acc[3] = {0, 0, 0};
+      for (int k = tx.offsets[x]; k < tx.offsets[x + 1]; ++k) {
+        const Rgba& p = image(tx.first[x] + k - tx.offsets[x], y);
+        const double wgt = tx.weights[k];
+        acc[0] += wgt * p.r;
+        acc[1] += wgt * p.g;
+        acc[2] += wgt * p.b;
+      }
+      for (int c = 0; c < 3; ++c) horizontal[c](x, y) = float(acc[c]);
+    }
+  });
+  std::array<Plane, 3> out;
+  for (Plane& p : out) p = Plane(w, h);
+  for_rows(h, threaded, [&](int y) {
+    for (int c = 0; c < 3; ++c)
+      for (int x = 0; x < w; ++x) {
+        double acc = 0;
+        for (int k = ty.offsets[y]; k < ty.offsets[y + 1]; ++k)
+          acc += double(ty.weights[k]) * horizontal[c](x, ty.first[y] + k - ty.offsets[y]);
+        out[c](x, y) = float(acc);
+      }
+  });
+  return out;
+}
+
+/// Linear sRGB primaries -> CIELAB (D65 white), in place: planes become L*, a*, b*.
+void rgb_to_lab(std::array<Plane, 3>& planes, bool threaded) {
+  constexpr double kXn = 0.95047, kYn = 1.0, kZn = 1.08883;
+  constexpr double kDelta = 6.0 / 29.0;
+  const auto f = [](double t) {
+    return t > kDelta * kDelta * kDelta ? std::cbrt(t) : t / (3.0 * kDelta * kDelta) + 4.0 / 29.0;
+  };
+  const int w = planes[0].width;
+  for_rows(planes[0].height, threaded, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      // Negative linear values (out-of-gamut renders) have no colorimetric meaning: clamp to black.
+      const double r = std::max(0.0f, planes[0](x, y));
+      const double g = std::max(0.0f, planes[1](x, y));
+      const double b = std::max(0.0f, planes[2](x, y));
+      const double fx = f((0.4124564 * r + 0.3575761 * g + 0.1804375 * b) / kXn);
+      const double fy = f((0.2126729 * r + 0.7151522 * g + 0.0721750 * b) / kYn);
+      const double fz = f((0.0193339 * r + 0.1191920 * g + 0.9503041 * b) / kZn);
+      planes[0](x, y) = float(116.0 * fy - 16.0);
+      planes[1](x, y) = float(500.0 * (fx - fy));
+      planes[2](x, y) = float(200.0 * (fy - fz));
+    }
+  });
+}
+
+/// One pyramid step: separable [1 4 6 4 1]/16 blur, keeping every second pixel (borders replicated).
+Plane reduce(const Plane& in, bool threaded) {
+  static constexpr float kTaps[5] = {1.f / 16, 4.f / 16, 6.f / 16, 4.f / 16, 1.f / 16};
+  const int w = (in.width + 1) / 2, h = (in.height + 1) / 2;
+  Plane horizontal(w, in.height);
+  for_rows(in.height, threaded, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      float acc = 0;
+      for (int k = -2; k <= 2; ++k) acc += kTaps[k + 2] * in(std::clamp(2 * x + k, 0, in.width - 1), y);
+      horizontal(x, y) = acc;
+    }
+  });
+  Plane out(w, h);
+  for_rows(h, threaded, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      float acc = 0;
+      for (int k = -2; k <= 2; ++k) acc += kTaps[k + 2] * horizontal(x, std::clamp(2 * y + k, 0, in.height - 1));
+      out(x, y) = acc;
+    }
+  });
+  return out;
+}
+
+/// Value of a coarser pyramid level at the centre of pixel (x, y) of a level `factor` times finer.
+/// Pixel i of level s+1 is centred on pixel 2i of level s (reduce() keeps even pixels), so the
+/// fractional index is simply x / factor; bilinear, clamped at the border.
+float sample_coarser(const Plane& coarse, int x, int y, int factor) {
+  const float fx = std::min(float(x) / float(factor), float(coarse.width - 1));
+  const float fy = std::min(float(y) / float(factor), float(coarse.height - 1));
+  const int x0 = int(fx), y0 = int(fy);
+  const int x1 = std::min(x0 + 1, coarse.width - 1), y1 = std::min(y0 + 1, coarse.height - 1);
+  const float tx = fx - float(x0), ty = fy - float(y0);
+  const float top = coarse(x0, y0) + tx * (coarse(x1, y0) - coarse(x0, y0));
+  const float bottom = coarse(x0, y1) + tx * (coarse(x1, y1) - coarse(x0, y1));
+  return top + ty * (bottom - top);
+}
+
+/// `coarse` resampled to the size of a level `factor` times finer.
+Plane expand_to(const Plane& coarse, int w, int h, int factor) {
+  Plane out(w, h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) out(x, y) = sample_coarser(coarse, x, y, factor);
+  return out;
+}
+
+using Kernel = std::array<float, (2 * kGaborRadius + 1) * (2 * kGaborRadius + 1)>;
+
+/// Even Gabor kernel, made zero-mean (a uniform patch gives no response) and scaled so its positive
+/// lobes sum to 1 (a step of height dL responds with at most dL, keeping the Lab contrast floor meaningful).
+Kernel gabor_kernel(double theta_rad) {
+  Kernel k{};
+  std::array<double, k.size()> raw{}, envelope{};
+  double sum_raw = 0, sum_env = 0;
+  for (int j = -kGaborRadius; j <= kGaborRadius; ++j)
+    for (int i = -kGaborRadius; i <= kGaborRadius; ++i) {
+      const std::size_t idx = std::size_t((j + kGaborRadius) * (2 * kGaborRadius + 1) + i + kGaborRadius);
+      const double rotated = i * std::cos(theta_rad) + j * std::sin(theta_rad);
+      envelope[idx] = std::exp(-(i * i + j * j) / (2.0 * kGaborSigmaPx * kGaborSigmaPx));
+      raw[idx] = envelope[idx] * std::cos(2.0 * M_PI * rotated / kGaborWavelengthPx);
+      sum_raw += raw[idx];
+      sum_env += envelope[idx];
+    }
+  double positive = 0;
+  for (std::size_t i = 0; i < k.size(); ++i) {
+    raw[i] -= sum_raw / sum_env * envelope[i];
+    positive += std::max(0.0, raw[i]);
+  }
+  for (std::size_t i = 0; i < k.size(); ++i) k[i] = float(raw[i] / positive);
+  return k;
+}
+
+/// |Gabor * L|, borders replicated.
+Plane gabor_energy(const Plane& lum, const Kernel& kernel, bool threaded) {
+  Plane out(lum.width, lum.height);
+  constexpr int kSide = 2 * kGaborRadius + 1;
+  for_rows(lum.height, threaded, [&](int y) {
+    for (int x = 0; x < lum.width; ++x) {
+      float acc = 0;
+      for (int j = 0; j < kSide; ++j) {
+        const int yy = std::clamp(y + j - kGaborRadius, 0, lum.height - 1);
+        for (int i = 0; i < kSide; ++i)
+          acc += kernel[std::size_t(j * kSide + i)] * lum(std::clamp(x + i - kGaborRadius, 0, lum.width - 1), yy);
+      }
+      out(x, y) = std::abs(acc);
+    }
+  });
+  return out;
+}
+
+/// The Itti N(.) operator, in place: maps whose maximum is below `floor` become zero; otherwise scale to
+/// [0,1] and multiply by (1 - m)^2, m = mean of the local maxima other than the global one (3x3
+/// neighbourhood, at least kLocalMaxThreshold). A plateau counts once: a pixel is a local maximum when
+/// it is >= all neighbours and > the neighbours that precede it in scan order.
+void normalize_map(Plane& map, float floor) {
+  const float peak = map.pixels.empty() ? 0.f : *std::max_element(map.pixels.begin(), map.pixels.end());
+  if (!(peak >= floor) || peak <= 0.f) {
+    std::fill(map.pixels.begin(), map.pixels.end(), 0.f);
+    return;
+  }
+  for (float& v : map.pixels) v /= peak;
+  double sum = 0;
+  int count = 0;
+  bool skipped_global = false;
+  for (int y = 0; y < map.height; ++y)
+    for (int x = 0; x < map.width; ++x) {
+      const float v = map(x, y);
+      if (v < kLocalMaxThreshold) continue;
+      bool is_max = true;
+      for (int dy = -1; dy <= 1 && is_max; ++dy)
+        for (int dx = -1; dx <= 1 && is_max; ++dx) {
+          const int xx = x + dx, yy = y + dy;
+          if ((dx == 0 && dy == 0) || xx < 0 || yy < 0 || xx >= map.width || yy >= map.height) continue;
+          const bool precedes = dy < 0 || (dy == 0 && dx < 0);
+          const float n = map(xx, yy);
+          is_max = precedes ? v > n : v >= n;
+        }
+      if (!is_max) continue;
+      if (v == 1.f && !skipped_global) {
+        skipped_global = true;
+        continue;
+      }
+      sum += v;
+      ++count;
+    }
+  const double mean_other = count > 0 ? sum / count : 0.0;
+  const float gain = float((1.0 - mean_other) * (1.0 - mean_other));
+  for (float& v : map.pixels) v *= gain;
+}
+
+/// One centre-surround feature map: which pyramid, which centre and surround level.
+struct FeatureSpec {
+  int channel;  // index into the pyramid list
+  int centre;
+  int surround;
+};
+
+}  // namespace
+
+int saliency_map_side(int image_side, double scale) {
+  return std::max(1, int(std::lround(double(image_side) * scale)));
+}
+
+ImageF compute_saliency(const ImageRGBA& image, const SaliencyOptions& options) {
+  validate(image, options);
+  const bool threaded = options.threaded;
+  const int w0 = saliency_map_side(image.width, options.scale);
+  const int h0 = saliency_map_side(image.height, options.scale);
+
+  std::array<Plane, 3> lab = downscale_rgb(image, w0, h0, threaded);
+  rgb_to_lab(lab, threaded);
+
+  // pyramids[channel][level]; channels 0..2 = L*, a*, b*, then one per Gabor orientation.
+  const int n_channels = options.use_orientation ? 3 + kOrientations : 3;
+  std::vector<std::vector<Plane>> pyramids{std::size_t(n_channels)};
+  for (int c = 0; c < 3; ++c) {
+    auto& levels = pyramids[std::size_t(c)];
+    levels.push_back(std::move(lab[std::size_t(c)]));
+    while (int(levels.size()) < kMaxLevels && std::min(levels.back().width, levels.back().height) > 1)
+      levels.push_back(reduce(levels.back(), threaded));
+  }
+  const int n_levels = int(pyramids[0].size());
+  if (options.use_orientation) {
+    // Level 0 takes part in no centre-surround pair, so its Gabor response is never needed.
+    for (int o = 0; o < kOrientations; ++o) {
+      const Kernel kernel = gabor_kernel(M_PI * o / kOrientations);
+      auto& levels = pyramids[std::size_t(3 + o)];
+      levels.resize(std::size_t(n_levels));
+      for (int l = 1; l < n_levels; ++l) levels[std::size_t(l)] = gabor_energy(pyramids[0][std::size_t(l)], kernel, threaded);
+    }
+  }
+
+  std::vector<std::pair<int, int>> pairs;
+  for (int c : kCentreLevels)
+    for (int d : kSurroundDeltas) {
+      const int s = std::min(c + d, n_levels - 1);
+      if (s > c && std::find(pairs.begin(), pairs.end(), std::make_pair(c, s)) == pairs.end()) pairs.emplace_back(c, s);
+    }
+  std::vector<FeatureSpec> specs;
+  for (int ch = 0; ch < n_channels; ++ch)
+    for (const auto& [c, s] : pairs) specs.push_back({ch, c, s});
+
+  // Each feature map is an independent task writing only its own slot; the sums below run in a
+  // fixed order, so the result does not depend on scheduling.
+  const Plane& base = pyramids[0][kConspicuityLevel];
+  std::vector<Plane> features(specs.size());
+  for_items(int(specs.size()), threaded, [&](int i) {
+    const FeatureSpec& f = specs[std::size_t(i)];
+    const Plane& centre = pyramids[std::size_t(f.channel)][std::size_t(f.centre)];
+    const Plane& surround = pyramids[std::size_t(f.channel)][std::size_t(f.surround)];
+    Plane diff(centre.width, centre.height);
+    const int factor = 1 << (f.surround - f.centre);
+    for (int y = 0; y < centre.height; ++y)
+      for (int x = 0; x < centre.width; ++x)
+        diff(x, y) = std::abs(centre(x, y) - sample_coarser(surround, x, y, factor));
+    normalize_map(diff, kContrastFloorLab);
+    const int up = 1 << (f.centre - kConspicuityLevel);
+    features[std::size_t(i)] = up == 1 ? std::move(diff) : expand_to(diff, base.width, base.height, up);
+  });
+
+  const auto sum_of = [&](int first_channel, int last_channel) {
+    Plane acc(base.width, base.height, 0.f);
+    for (std::size_t i = 0; i < specs.size(); ++i)
+      if (specs[i].channel >= first_channel && specs[i].channel <= last_channel)
+        for (std::size_t p = 0; p < acc.size(); ++p) acc.pixels[p] += features[i].pixels[p];
+    return acc;
+  };
+  std::vector<Plane> conspicuity;
+  conspicuity.push_back(sum_of(0, 0));
+  conspicuity.push_back(sum_of(1, 2));
+  if (options.use_orientation) {
+    Plane orientation(base.width, base.height, 0.f);
+    for (int o = 0; o < kOrientations; ++o) {
+      Plane per_angle = sum_of(3 + o, 3 + o);
+      normalize_map(per_angle, 0.f);
+      for (std::size_t p = 0; p < orientation.size(); ++p) orientation.pixels[p] += per_angle.pixels[p];
+    }
+    conspicuity.push_back(std::move(orientation));
+  }
+  Plane combined(base.width, base.height, 0.f);
+  for (Plane& map : conspicuity) {
+    normalize_map(map, 0.f);
+    for (std::size_t p = 0; p < combined.size(); ++p) combined.pixels[p] += map.pixels[p] / float(conspicuity.size());
+  }
+
+  ImageF out = expand_to(combined, w0, h0, 1 << kConspicuityLevel);
+  const float peak = *std::max_element(out.pixels.begin(), out.pixels.end());
+  if (peak > 0.f)
+    for (float& v : out.pixels) v = std::clamp(v / peak, 0.f, 1.f);
+  return out;
+}
+
+}  // namespace raysift::features
