@@ -22,6 +22,7 @@
 #include "core/image.h"
 #include "core/vec.h"
 #include "features/lines.h"
+#include "features/visibility.h"
 #include "mesh/curvature.h"
 #include "mesh/tri_mesh.h"
 
@@ -33,6 +34,8 @@ struct ImportanceOptions {
   std::array<float, kLineClassCount> priority{1.0f, 1.0f, 0.6f, 0.6f, 0.6f, 0.6f};
   double falloff_px = 8.0;          ///< fall-off radius in FRAME pixels (> 0); smoothstep from line to 0
   float background_value = -1.0f;   ///< must be < 0
+  /// Used by compute_importance only; its `classes` and `threaded` fields are taken from the line options.
+  VisibilityOptions visibility;
   bool threaded = true;
 };
 

@@ -2,8 +2,8 @@
 /// \file DeCarlo-style line features of a triangle mesh for one eye position (DeCarlo et al. 2003,
 /// DeCarlo, Finkelstein & Rusinkiewicz 2004, DeCarlo & Rusinkiewicz 2007, Ohtake et al. 2004), following
 /// the rtsc viewer's formulas (see docs/feature_lines.md and ALGORITHMS.md §5). Key decision: every line is
-/// a set of independent 3D segments, at most one per face and class, so extraction is one parallel pass
-/// over faces; exterior silhouettes are classified later, by features/visibility.h, because "borders the
+/// a set of independent 3D segments, at most three per face and class, so extraction is one parallel
+/// pass over faces; exterior silhouettes are classified later, by features/visibility.h, because "borders the
 /// background" is an image-space property.
 #include <cstdint>
 #include <string>

@@ -1,0 +1,171 @@
+#include "features/raster.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "core/errors.h"
+
+namespace raysift::features {
+namespace {
+
+constexpr int kBandRows = 16;
+
+struct ScreenTri {
+  double x[3], y[3], inv_z[3];
+  std::uint32_t face;
+};
+
+struct ViewPoint {
+  double x, y, z;  // along right, image up, forward (z = view depth)
+};
+
+template <typename F>
+void for_chunks(std::size_t n, std::size_t chunk, bool threaded, const F& body) {
+  const std::size_t chunks = (n + chunk - 1) / chunk;
+  auto run = [&](std::size_t c) { body(c, c * chunk, std::min(n, (c + 1) * chunk)); };
+  if (threaded) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t c = r.begin(); c != r.end(); ++c) run(c);
+    });
+  } else {
+    for (std::size_t c = 0; c < chunks; ++c) run(c);
+  }
+}
+
+}  // namespace
+
+CameraSpec scaled_camera(const CameraSpec& spec, double scale) {
+  if (!(scale > 0.0 && scale <= 1.0))
+    throw InvalidInput("scale must be in (0, 1], got " + std::to_string(scale));
+  CameraSpec s = spec;
+  s.width = std::max(1, int(std::lround(spec.width * scale)));
+  s.height = std::max(1, int(std::lround(spec.height * scale)));
+  return s;
+}
+
+DepthBuffer rasterize_depth(const mesh::TriMesh& mesh, const Camera& camera, const RasterOptions& options) {
+  const int width = camera.width(), height = camera.height();
+  DepthBuffer out{camera.spec(), ImageF(width, height, std::numeric_limits<float>::infinity()),
+                  ImageU32(width, height, kNoFace)};
+  Bbox3d box;
+  for (std::size_t f = 0; f < mesh.triangle_count(); ++f)
+    for (std::uint32_t v : mesh.triangles[f]) {
+      if (v >= mesh.vertex_count())
+        throw InvalidInput("rasterize: triangle " + std::to_string(f) + " references vertex " + std::to_string(v) +
+                           " of " + std::to_string(mesh.vertex_count()));
+      if (!is_finite(mesh.positions[v]))
+        throw InvalidInput("rasterize: vertex " + std::to_string(v) + " has a NaN or infinite coordinate");
+      box.expand(Vec3d(mesh.positions[v]));
+    }
+  if (mesh.empty()) return out;
+  // Relative to the scene size: closer than this to the eye plane a vertex is clipped away.
+  const double near = std::max(1e-6 * box.diagonal(), 1e-30);
+  const double tan_y = std::tan(camera.spec().fov_y_deg * M_PI / 360.0);
+  const double tan_x = tan_y * double(width) / double(height);
+
+  std::vector<ViewPoint> view(mesh.vertex_count());
+  for_chunks(view.size(), 8192, options.threaded, [&](std::size_t, std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      const Vec3d d = Vec3d(mesh.positions[i]) - camera.eye();
+      view[i] = {dot(d, camera.right()), dot(d, camera.image_up()), dot(d, camera.forward())};
+    }
+  });
+
+  // Clip each triangle at the near plane (Sutherland-Hodgman against one plane) and project it.
+  constexpr std::size_t kChunk = 8192;
+  std::vector<std::vector<ScreenTri>> parts((mesh.triangle_count() + kChunk - 1) / kChunk);
+  for_chunks(mesh.triangle_count(), kChunk, options.threaded, [&](std::size_t c, std::size_t b, std::size_t e) {
+    for (std::size_t f = b; f < e; ++f) {
+      const auto& t = mesh.triangles[f];
+      ViewPoint poly[4];
+      int n = 0;
+      for (int k = 0; k < 3; ++k) {
+        const ViewPoint& p = view[t[k]];
+        const ViewPoint& q = view[t[(k + 1) % 3]];
+        if (p.z >= near) poly[n++] = p;
+        if ((p.z >= near) != (q.z >= near)) {
+          const double s = (near - p.z) / (q.z - p.z);
+          poly[n++] = {p.x + s * (q.x - p.x), p.y + s * (q.y - p.y), near};
+        }
+      }
+      for (int k = 1; k + 1 < n; ++k) {
+        ScreenTri st;
+        st.face = std::uint32_t(f);
+        const ViewPoint* corner[3] = {&poly[0], &poly[k], &poly[k + 1]};
+        for (int j = 0; j < 3; ++j) {
+          st.x[j] = (corner[j]->x / corner[j]->z / tan_x + 1.0) * 0.5 * width;
+          st.y[j] = (1.0 - corner[j]->y / corner[j]->z / tan_y) * 0.5 * height;
+          st.inv_z[j] = 1.0 / corner[j]->z;
+        }
+        parts[c].push_back(st);
+      }
+    }
+  });
+  std::vector<ScreenTri> tris;
+  for (auto& p : parts) tris.insert(tris.end(), p.begin(), p.end());
+
+  // Pixel rows whose centres (r + 0.5) a triangle spans; binned into bands of rows, in triangle order.
+  auto row_range = [&](const ScreenTri& st, int& r0, int& r1) {
+    const double y0 = std::min({st.y[0], st.y[1], st.y[2]}), y1 = std::max({st.y[0], st.y[1], st.y[2]});
+    r0 = int(std::max(0.0, std::ceil(y0 - 0.5)));
+    r1 = int(std::min(double(height - 1), std::floor(y1 - 0.5)));
+  };
+  const int bands = (height + kBandRows - 1) / kBandRows;
+  std::vector<std::uint32_t> band_offset(std::size_t(bands) + 1, 0);
+  for (const ScreenTri& st : tris) {
+    int r0, r1;
+    row_range(st, r0, r1);
+    for (int b = r0 / kBandRows; r0 <= r1 && b <= r1 / kBandRows; ++b) ++band_offset[std::size_t(b) + 1];
+  }
+  for (int b = 0; b < bands; ++b) band_offset[std::size_t(b) + 1] += band_offset[std::size_t(b)];
+  std::vector<std::uint32_t> band_tris(band_offset.back());
+  std::vector<std::uint32_t> fill(band_offset.begin(), band_offset.end() - 1);
+  for (std::size_t i = 0; i < tris.size(); ++i) {
+    int r0, r1;
+    row_range(tris[i], r0, r1);
+    for (int b = r0 / kBandRows; r0 <= r1 && b <= r1 / kBandRows; ++b) band_tris[fill[std::size_t(b)]++] = std::uint32_t(i);
+  }
+
+  for_chunks(std::size_t(bands), 1, options.threaded, [&](std::size_t band, std::size_t, std::size_t) {
+    const int band_r0 = int(band) * kBandRows, band_r1 = std::min(height - 1, band_r0 + kBandRows - 1);
+    for (std::uint32_t k = band_offset[band]; k < band_offset[band + 1]; ++k) {
+      const ScreenTri& st = tris[band_tris[k]];
+      const double area = (st.x[1] - st.x[0]) * (st.y[2] - st.y[0]) - (st.x[2] - st.x[0]) * (st.y[1] - st.y[0]);
+      if (!(std::abs(area) > 1e-12)) continue;
+      int r0, r1;
+      row_range(st, r0, r1);
+      r0 = std::max(r0, band_r0);
+      r1 = std::min(r1, band_r1);
+      const double x0 = std::min({st.x[0], st.x[1], st.x[2]}), x1 = std::max({st.x[0], st.x[1], st.x[2]});
+      const int c0 = int(std::max(0.0, std::ceil(x0 - 0.5)));
+      const int c1 = int(std::min(double(width - 1), std::floor(x1 - 0.5)));
+      for (int r = r0; r <= r1; ++r) {
+        const double py = r + 0.5;
+        for (int col = c0; col <= c1; ++col) {
+          const double px = col + 0.5;
+          double b[3];
+          for (int j = 0; j < 3; ++j) {
+            const int a = (j + 1) % 3, c = (j + 2) % 3;
+            b[j] = ((st.x[c] - st.x[a]) * (py - st.y[a]) - (px - st.x[a]) * (st.y[c] - st.y[a])) / area;
+          }
+          if (b[0] < 0 || b[1] < 0 || b[2] < 0) continue;
+          const float z = float(1.0 / (b[0] * st.inv_z[0] + b[1] * st.inv_z[1] + b[2] * st.inv_z[2]));
+          float& cur = out.depth(col, r);
+          std::uint32_t& cur_face = out.face(col, r);
+          if (z < cur || (z == cur && st.face < cur_face)) {
+            cur = z;
+            cur_face = st.face;
+          }
+        }
+      }
+    }
+  });
+  return out;
+}
+
+}  // namespace raysift::features
