@@ -9,11 +9,9 @@
 
 #include "core/image.h"
 #include "core/json_io.h"
+#include "sampling/image_mask.h"
 
 namespace raysift::sampling {
-
-/// One byte per pixel; non-zero = selected.
-using ImageMask = Image<std::uint8_t>;
 
 /// PSNR of identical images is reported as this cap (dB) rather than +inf, so JSON and plots stay finite.
 inline constexpr double kPsnrCapDb = 100.0;

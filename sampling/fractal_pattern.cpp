@@ -1,0 +1,59 @@
+#include "sampling/fractal_pattern.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <string>
+
+#include "core/camera.h"
+#include "core/errors.h"
+
+namespace raysift::sampling {
+namespace {
+int log2_exact(int v) {
+  int n = 0;
+  while ((1 << n) < v) ++n;
+  return n;
+}
+}  // namespace
+
+int fractal_level(int x, int y, int base_spacing) {
+  if (x % base_spacing == 0 && y % base_spacing == 0) return 0;
+  const int levels_below = log2_exact(base_spacing);
+  // The coarsest h (power of two below S) that divides both coordinates decides the level: the pixel is
+  // a centre of a square (both x/h, y/h odd) or of a diamond (exactly one odd) of half-size h.
+  for (int m = 0, h = base_spacing / 2; m < levels_below; ++m, h /= 2) {
+    if (x % h != 0 || y % h != 0) continue;
+    const bool square_centre = (x / h) % 2 == 1 && (y / h) % 2 == 1;
+    return square_centre ? 2 * m + 1 : 2 * m + 2;
+  }
+  RAYSIFT_CHECK(false);  // h = 1 divides everything
+  return 0;
+}
+
+int parent_offset(int level, int base_spacing) {
+  RAYSIFT_DCHECK(level >= 1);
+  return base_spacing >> ((level + 1) / 2);
+}
+
+float pattern_priority(int level, int num_levels) { return 1.0f - float(level) / float(num_levels); }
+
+FractalPattern make_fractal_pattern(int width, int height, int base_spacing) {
+  if (width < 1 || height < 1 || width > kMaxImageSide || height > kMaxImageSide)
+    throw InvalidInput("fractal pattern: image size " + std::to_string(width) + "x" + std::to_string(height) +
+                       " outside 1.." + std::to_string(kMaxImageSide));
+  if (base_spacing < 1 || base_spacing > 128 || (base_spacing & (base_spacing - 1)) != 0)
+    throw InvalidInput("fractal pattern: base spacing must be a power of two in 1..128, got " +
+                       std::to_string(base_spacing));
+  FractalPattern pattern;
+  pattern.base_spacing = base_spacing;
+  pattern.num_levels = 1 + 2 * log2_exact(base_spacing);
+  pattern.level = Image<std::uint8_t>(width, height, 0);
+  tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y < rows.end(); ++y)
+      for (int x = 0; x < width; ++x) pattern.level(x, y) = std::uint8_t(fractal_level(x, y, base_spacing));
+  });
+  return pattern;
+}
+
+}  // namespace raysift::sampling

@@ -1,0 +1,34 @@
+#pragma once
+/// \file The square/diamond fractal sampling pattern of the ray-prioritization paper (Steinberger,
+/// Kainz et al. 2012, section 4.3). Level 0 is a square lattice with spacing S (a power of two,
+/// default 8 px). Each further pair of levels first adds the centres of the current squares (a diamond
+/// lattice results), then the centres of the diamonds (a square lattice of half the spacing), until
+/// every pixel is covered exactly once: 1 + 2 log2(S) levels. The lattice is anchored at pixel (0,0).
+#include <cstdint>
+
+#include "core/image.h"
+
+namespace raysift::sampling {
+
+/// Level of every pixel of a frame, plus the pattern parameters.
+struct FractalPattern {
+  int base_spacing = 8;   ///< S, pixels, a power of two >= 1
+  int num_levels = 7;     ///< 1 + 2 log2(S)
+  Image<std::uint8_t> level;  ///< 0 .. num_levels-1 per pixel
+};
+
+/// \throw InvalidInput if width/height are not in 1..16384 or base_spacing is not a power of two in 1..128.
+FractalPattern make_fractal_pattern(int width, int height, int base_spacing = 8);
+
+/// Level of pixel (x,y) for a lattice of spacing S anchored at (0,0). \pre x, y >= 0, S a power of two.
+int fractal_level(int x, int y, int base_spacing);
+
+/// Pattern priority p_patt: 1 at level 0, falling linearly by 1/num_levels per level (the finest level
+/// keeps 1/num_levels > 0).
+float pattern_priority(int level, int num_levels);
+
+/// Half-distance h to the four parents of a pixel at `level` >= 1: odd levels (square centres) have
+/// parents at (x±h, y±h), even levels (diamond centres) at (x±h, y) and (x, y±h).
+int parent_offset(int level, int base_spacing);
+
+}  // namespace raysift::sampling

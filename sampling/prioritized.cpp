@@ -1,0 +1,224 @@
+#include "sampling/prioritized.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/errors.h"
+#include "sampling/reconstruction.h"
+
+namespace raysift::sampling {
+namespace {
+
+void require_finite_importance(const ImageF& importance) {
+  if (importance.width < 1 || importance.height < 1) throw InvalidInput("importance buffer is empty (0x0)");
+  for (std::size_t i = 0; i < importance.size(); ++i)
+    if (!std::isfinite(importance.pixels[i]))
+      throw InvalidInput("importance buffer has a NaN/Inf value at pixel (" +
+                         std::to_string(i % std::size_t(importance.width)) + "," +
+                         std::to_string(i / std::size_t(importance.width)) + ")");
+}
+
+ImageMask background_known(const ImageF& importance) {
+  ImageMask known(importance.width, importance.height, 0);
+  for (std::size_t i = 0; i < importance.size(); ++i) known.pixels[i] = importance.pixels[i] < 0 ? 1 : 0;
+  return known;
+}
+
+void mark(Span<const std::uint32_t> pixels, ImageMask& mask) {
+  for (std::uint32_t p : pixels) mask.pixels[p] = 1;
+}
+
+std::size_t ray_target(const SamplingOptions& options, std::size_t object, std::size_t level0) {
+  const auto wanted = std::size_t(std::llround(options.ray_fraction * double(object)));
+  return std::min(object, std::max(level0, wanted));
+}
+
+}  // namespace
+
+SamplingMode parse_sampling_mode(const std::string& name) {
+  if (name == "full") return SamplingMode::Full;
+  if (name == "prioritized") return SamplingMode::Prioritized;
+  if (name == "subsample") return SamplingMode::Subsample;
+  throw InvalidInput("--mode must be one of: full, prioritized, subsample; got '" + name + "'");
+}
+
+const char* sampling_mode_name(SamplingMode mode) {
+  switch (mode) {
+    case SamplingMode::Full: return "full";
+    case SamplingMode::Prioritized: return "prioritized";
+    case SamplingMode::Subsample: return "subsample";
+  }
+  return "?";
+}
+
+void validate(const SamplingOptions& o) {
+  if (!(o.ray_fraction > 0.0 && o.ray_fraction <= 1.0))
+    throw InvalidInput("--ray-fraction must be in (0, 1], got " + std::to_string(o.ray_fraction));
+  if (!std::isfinite(o.budget_ms) || o.budget_ms < 0)
+    throw InvalidInput("--budget-ms must be >= 0 (0 = no budget), got " + std::to_string(o.budget_ms));
+  if (o.base_spacing < 1 || o.base_spacing > 128 || (o.base_spacing & (o.base_spacing - 1)) != 0)
+    throw InvalidInput("fractal base spacing must be a power of two in 1..128, got " + std::to_string(o.base_spacing));
+  if (o.buckets < 1 || o.buckets > 65536)
+    throw InvalidInput("priority bucket count must be in 1..65536, got " + std::to_string(o.buckets));
+  for (float a : o.mapping.alpha)
+    if (!std::isfinite(a)) throw InvalidInput("--alpha coefficients must be finite");
+}
+
+ImageF control_importance(const ImageF& importance) {
+  ImageF out = importance;
+  for (float& v : out.pixels) v = v < 0 ? v : 0.0f;
+  return out;
+}
+
+double estimate_reconstruct_ms(int width, int height, int base_spacing) {
+  const int cw = std::min(width, 512), ch = std::min(height, 512);
+  const FractalPattern pattern = make_fractal_pattern(cw, ch, base_spacing);
+  ImageMask known(cw, ch, 0);
+  for (std::size_t i = 0; i < known.size(); ++i) known.pixels[i] = pattern.level.pixels[i] == 0 ? 1 : 0;
+  ImageRGBA image(cw, ch);
+  const Timer timer;
+  reconstruct_fractal(image, known, pattern);
+  return timer.elapsed_ms() * double(width) * double(height) / (double(cw) * double(ch));
+}
+
+SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, const SamplingOptions& options,
+                            double elapsed_before_ms) {
+  validate(options);
+  require_finite_importance(importance);
+  const Timer clock;
+  const int w = importance.width, h = importance.height;
+  SampledFrame frame;
+  frame.image = ImageRGBA(w, h);
+  frame.traced = ImageMask(w, h, 0);
+
+  Timer stage;
+  const FractalPattern pattern = make_fractal_pattern(w, h, options.base_spacing);
+  const ObjectCounts counts = count_object_pixels(importance, pattern);
+  frame.full_rays = counts.object;
+  frame.level0_rays = counts.level0;
+  const std::size_t target = ray_target(options, counts.object, counts.level0);
+
+  if (options.mode == SamplingMode::Full) {
+    std::vector<std::uint32_t> all;
+    all.reserve(counts.object);
+    for (std::size_t i = 0; i < importance.size(); ++i)
+      if (importance.pixels[i] >= 0) all.push_back(std::uint32_t(i));
+    frame.priorities_ms = stage.elapsed_ms();
+    stage.reset();
+    trace_all(all, trace, frame.image);
+    frame.trace_ms = stage.elapsed_ms();
+    mark(all, frame.traced);
+    frame.rays_traced = all.size();
+    return frame;
+  }
+
+  if (options.mode == SamplingMode::Subsample) {
+    const SampleGrid grid = subsample_grid_for(importance, target, nullptr);
+    std::vector<std::uint32_t> rays;
+    for (int y : grid.ys)
+      for (int x : grid.xs)
+        if (importance(x, y) >= 0) rays.push_back(std::uint32_t(y) * std::uint32_t(w) + std::uint32_t(x));
+    frame.priorities_ms = stage.elapsed_ms();
+    stage.reset();
+    trace_all(rays, trace, frame.image);
+    frame.trace_ms = stage.elapsed_ms();
+    mark(rays, frame.traced);
+    frame.rays_traced = rays.size();
+    stage.reset();
+    if (rays.size() < counts.object) reconstruct_bilinear(frame.image, grid, background_known(importance));
+    frame.reconstruct_ms = stage.elapsed_ms();
+    return frame;
+  }
+
+  RayQueue queue;
+  if (options.budget_ms > 0) {
+    queue = make_bucketed_queue(importance, pattern, options.mapping, options.buckets, options.seed);
+    frame.priorities_ms = stage.elapsed_ms();
+    const double reserve = options.reconstruct_reserve_ms >= 0 ? options.reconstruct_reserve_ms
+                                                                : estimate_reconstruct_ms(w, h, options.base_spacing);
+    stage.reset();
+    const Span<const std::uint32_t> all(queue.pixels.data(), queue.pixels.size());
+    trace_all(Span<const std::uint32_t>(all.data(), queue.level0_count), trace, frame.image);
+    const double deadline = options.budget_ms - elapsed_before_ms - reserve;
+    frame.budget_too_small = clock.elapsed_ms() > deadline;
+    const std::size_t more = trace_until(Span<const std::uint32_t>(all.data() + queue.level0_count,
+                                                                   all.size() - queue.level0_count),
+                                         trace, frame.image, clock, deadline);
+    frame.rays_traced = queue.level0_count + more;
+    frame.trace_ms = stage.elapsed_ms();
+  } else {
+    queue = select_top_rays(importance, pattern, options.mapping, target, options.seed, options.threshold);
+    frame.priorities_ms = stage.elapsed_ms();
+    stage.reset();
+    trace_all(queue.pixels, trace, frame.image);
+    frame.rays_traced = queue.pixels.size();
+    frame.trace_ms = stage.elapsed_ms();
+  }
+  mark(Span<const std::uint32_t>(queue.pixels.data(), frame.rays_traced), frame.traced);
+
+  stage.reset();
+  if (frame.rays_traced < counts.object) {
+    ImageMask known = background_known(importance);
+    for (std::size_t i = 0; i < known.size(); ++i) known.pixels[i] |= frame.traced.pixels[i];
+    reconstruct_fractal(frame.image, known, pattern);
+  }
+  frame.reconstruct_ms = stage.elapsed_ms();
+  return frame;
+}
+
+ProgressiveSampler::ProgressiveSampler(const ImageF& importance, const SamplingOptions& options) : options_(options) {
+  validate(options);
+  require_finite_importance(importance);
+  if (options.mode != SamplingMode::Prioritized)
+    throw InvalidInput("--progressive needs --mode prioritized, got " + std::string(sampling_mode_name(options.mode)));
+  const Timer timer;
+  pattern_ = make_fractal_pattern(importance.width, importance.height, options.base_spacing);
+  queue_ = make_bucketed_queue(importance, pattern_, options.mapping, options.buckets, options.seed);
+  samples_ = ImageRGBA(importance.width, importance.height);
+  known_ = background_known(importance);
+  priorities_ms_ = timer.elapsed_ms();
+}
+
+SampledFrame ProgressiveSampler::next_frame(const TraceBatch& trace) {
+  const Timer clock;
+  SampledFrame frame;
+  frame.full_rays = queue_.object_pixels;
+  frame.level0_rays = queue_.level0_count;
+  frame.priorities_ms = priorities_ms_;  // the queue is built once; later frames reuse it
+  priorities_ms_ = 0;
+  const Span<const std::uint32_t> all(queue_.pixels.data(), queue_.pixels.size());
+  const std::size_t begin = next_;
+
+  Timer stage;
+  if (next_ == 0) {
+    trace_all(Span<const std::uint32_t>(all.data(), queue_.level0_count), trace, samples_);
+    next_ = queue_.level0_count;
+  }
+  if (options_.budget_ms > 0) {
+    const double reserve = options_.reconstruct_reserve_ms >= 0
+                               ? options_.reconstruct_reserve_ms
+                               : estimate_reconstruct_ms(samples_.width, samples_.height, options_.base_spacing);
+    const double deadline = options_.budget_ms - reserve;
+    frame.budget_too_small = begin == 0 && clock.elapsed_ms() > deadline;
+    next_ += trace_until(Span<const std::uint32_t>(all.data() + next_, all.size() - next_), trace, samples_, clock,
+                         deadline);
+  } else {
+    const auto step = std::size_t(std::llround(options_.ray_fraction * double(queue_.object_pixels)));
+    const std::size_t end = std::min(all.size(), std::max(next_, begin + std::max<std::size_t>(step, 1)));
+    trace_all(Span<const std::uint32_t>(all.data() + next_, end - next_), trace, samples_);
+    next_ = end;
+  }
+  frame.trace_ms = stage.elapsed_ms();
+  mark(Span<const std::uint32_t>(all.data() + begin, next_ - begin), known_);
+
+  frame.traced = ImageMask(samples_.width, samples_.height, 0);
+  mark(Span<const std::uint32_t>(all.data(), next_), frame.traced);
+  frame.rays_traced = next_;
+  stage.reset();
+  frame.image = samples_;
+  if (!converged()) reconstruct_fractal(frame.image, known_, pattern_);
+  frame.reconstruct_ms = stage.elapsed_ms();
+  return frame;
+}
+
+}  // namespace raysift::sampling

@@ -1,0 +1,214 @@
+#include "sampling/reconstruction.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace raysift::sampling {
+namespace {
+
+struct Corner {
+  int x, y;
+  float weight;
+};
+
+Rgba weighted_sum(const ImageRGBA& image, const std::array<Corner, 4>& corners) {
+  Rgba out;
+  for (const Corner& c : corners) {
+    const Rgba& p = image(c.x, c.y);
+    out.r += c.weight * p.r;
+    out.g += c.weight * p.g;
+    out.b += c.weight * p.b;
+    out.a += c.weight * p.a;
+  }
+  return out;
+}
+
+Rgba clamp01(Rgba p) {
+  auto c = [](float v) { return std::min(1.0f, std::max(0.0f, v)); };
+  return {c(p.r), c(p.g), c(p.b), c(p.a)};
+}
+
+// Square cell of a lattice with spacing h along one axis: start x0 and coordinate u in cell units.
+// Cells are shifted left so they end inside the image (u > 1 then extrapolates); a lattice with a single
+// line along this axis degenerates to a constant (u = 0).
+void square_axis(int x, int extent, int h, int& x0, int& x1, float& u) {
+  const int last = ((extent - 1) / h) * h;
+  if (last == 0) {
+    x0 = x1 = 0;
+    u = 0;
+    return;
+  }
+  x0 = std::min((x / h) * h, last - h);
+  x1 = x0 + h;
+  u = float(x - x0) / float(h);
+}
+
+// Corners and bilinear weights of the cell of lattice state k around (x,y). State 2m is the square
+// lattice of spacing S>>m; state 2m+1 adds the square centres, a diamond lattice of half-spacing
+// g = (S>>m)/2, interpolated in the rotated coordinates U = (x+y)/2g, V = (x-y)/2g.
+// Returns false if a corner falls outside the image.
+bool cell_corners(int x, int y, int state, int spacing, int w, int h, std::array<Corner, 4>& corners) {
+  const int m = state / 2;
+  if (state % 2 == 0) {
+    const int step = spacing >> m;
+    int x0, x1, y0, y1;
+    float u, v;
+    square_axis(x, w, step, x0, x1, u);
+    square_axis(y, h, step, y0, y1, v);
+    corners = {Corner{x0, y0, (1 - u) * (1 - v)}, Corner{x1, y0, u * (1 - v)}, Corner{x0, y1, (1 - u) * v},
+               Corner{x1, y1, u * v}};
+    return true;
+  }
+  const int g = (spacing >> m) / 2;
+  const int su = x + y, sv = x - y;  // U = su / 2g, V = sv / 2g
+  const int a0 = int(std::floor(float(su) / float(2 * g))), b0 = int(std::floor(float(sv) / float(2 * g)));
+  const float s = float(su - 2 * g * a0) / float(2 * g), t = float(sv - 2 * g * b0) / float(2 * g);
+  const std::array<std::array<int, 2>, 4> ab = {{{a0, b0}, {a0 + 1, b0}, {a0, b0 + 1}, {a0 + 1, b0 + 1}}};
+  const std::array<float, 4> weights = {(1 - s) * (1 - t), s * (1 - t), (1 - s) * t, s * t};
+  for (int i = 0; i < 4; ++i) {
+    const int cx = g * (ab[i][0] + ab[i][1]), cy = g * (ab[i][0] - ab[i][1]);
+    if (cx < 0 || cy < 0 || cx >= w || cy >= h) return false;
+    corners[i] = {cx, cy, weights[i]};
+  }
+  return true;
+}
+
+template <typename Fn>
+void for_each_row(int height, Fn&& fn) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y < rows.end(); ++y) fn(y);
+  });
+}
+
+}  // namespace
+
+void reconstruct_fractal(ImageRGBA& image, const ImageMask& known, const FractalPattern& pattern) {
+  const int w = image.width, h = image.height, spacing = pattern.base_spacing;
+  RAYSIFT_CHECK(known.width == w && known.height == h);
+  RAYSIFT_CHECK(pattern.level.width == w && pattern.level.height == h);
+
+  // Pass 1: complete anchors whose four parents were traced. Reads only `known` pixels, writes only
+  // unknown ones, so rows are independent.
+  ImageMask available = known;
+  for_each_row(h, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      if (known(x, y)) continue;
+      const int level = pattern.level(x, y);
+      const int d = parent_offset(level, spacing);
+      std::array<Corner, 4> parents;
+      if (level % 2 == 1)
+        parents = {Corner{x - d, y - d, 0.25f}, Corner{x + d, y - d, 0.25f}, Corner{x - d, y + d, 0.25f},
+                   Corner{x + d, y + d, 0.25f}};
+      else
+        parents = {Corner{x - d, y, 0.25f}, Corner{x + d, y, 0.25f}, Corner{x, y - d, 0.25f},
+                   Corner{x, y + d, 0.25f}};
+      bool complete = true;
+      for (const Corner& c : parents)
+        complete = complete && c.x >= 0 && c.y >= 0 && c.x < w && c.y < h && known(c.x, c.y);
+      if (!complete) continue;
+      image(x, y) = weighted_sum(image, parents);
+      available(x, y) = 1;
+    }
+  });
+
+  // Pass 2: interpolate the rest from the finest complete cell. Reads only `available` pixels.
+  for_each_row(h, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      if (available(x, y)) continue;
+      const int level = pattern.level(x, y);
+      bool done = false;
+      Rgba partial;
+      float partial_weight = 0;
+      for (int state = level - 1; state >= 0 && !done; --state) {
+        std::array<Corner, 4> corners;
+        if (!cell_corners(x, y, state, spacing, w, h, corners)) continue;
+        bool complete = true;
+        for (const Corner& c : corners) complete = complete && available(c.x, c.y);
+        if (complete) {
+          image(x, y) = clamp01(weighted_sum(image, corners));
+          done = true;
+        } else if (state == 0) {
+          // Only reached when level-0 anchors are missing (not in the prioritized pipeline).
+          for (const Corner& c : corners) {
+            if (!available(c.x, c.y)) continue;
+            const Rgba& p = image(c.x, c.y);
+            partial = {partial.r + p.r, partial.g + p.g, partial.b + p.b, partial.a + p.a};
+            partial_weight += 1;
+          }
+        }
+      }
+      if (!done) {
+        const float inv = partial_weight > 0 ? 1.0f / partial_weight : 0.0f;
+        image(x, y) = clamp01({partial.r * inv, partial.g * inv, partial.b * inv, partial.a * inv});
+      }
+    }
+  });
+}
+
+SampleGrid make_sample_grid(int width, int height, double step_px) {
+  RAYSIFT_CHECK(step_px >= 1.0);
+  SampleGrid grid;
+  auto axis = [&](int extent, std::vector<int>& out) {
+    for (int i = 0;; ++i) {
+      const int p = int(std::lround((i + 0.5) * step_px - 0.5));
+      if (p >= extent) break;
+      if (out.empty() || p > out.back()) out.push_back(p);
+    }
+  };
+  axis(width, grid.xs);
+  axis(height, grid.ys);
+  return grid;
+}
+
+void reconstruct_bilinear(ImageRGBA& image, const SampleGrid& grid, const ImageMask& fixed) {
+  RAYSIFT_CHECK(!grid.xs.empty() && !grid.ys.empty());
+  RAYSIFT_CHECK(fixed.width == image.width && fixed.height == image.height);
+  // Per axis: the bracketing grid lines and the weight of the upper one.
+  struct Axis {
+    std::vector<int> lo, hi;
+    std::vector<float> t;
+  };
+  auto make_axis = [](int extent, const std::vector<int>& lines) {
+    Axis a;
+    a.lo.resize(extent);
+    a.hi.resize(extent);
+    a.t.resize(extent);
+    std::size_t k = 0;
+    for (int p = 0; p < extent; ++p) {
+      while (k + 1 < lines.size() && lines[k + 1] <= p) ++k;
+      if (p <= lines.front()) {
+        a.lo[p] = a.hi[p] = lines.front();
+        a.t[p] = 0;
+      } else if (k + 1 >= lines.size()) {
+        a.lo[p] = a.hi[p] = lines.back();
+        a.t[p] = 0;
+      } else {
+        a.lo[p] = lines[k];
+        a.hi[p] = lines[k + 1];
+        a.t[p] = float(p - lines[k]) / float(lines[k + 1] - lines[k]);
+      }
+    }
+    return a;
+  };
+  const Axis ax = make_axis(image.width, grid.xs), ay = make_axis(image.height, grid.ys);
+  // Grid pixels keep their traced values; every other pixel reads only grid pixels.
+  std::vector<std::uint8_t> is_col(image.width, 0), is_row(image.height, 0);
+  for (int x : grid.xs) is_col[x] = 1;
+  for (int y : grid.ys) is_row[y] = 1;
+  for_each_row(image.height, [&](int y) {
+    for (int x = 0; x < image.width; ++x) {
+      if ((is_col[x] && is_row[y]) || fixed(x, y)) continue;
+      const float u = ax.t[x], v = ay.t[y];
+      const std::array<Corner, 4> corners = {Corner{ax.lo[x], ay.lo[y], (1 - u) * (1 - v)},
+                                             Corner{ax.hi[x], ay.lo[y], u * (1 - v)},
+                                             Corner{ax.lo[x], ay.hi[y], (1 - u) * v}, Corner{ax.hi[x], ay.hi[y], u * v}};
+      image(x, y) = clamp01(weighted_sum(image, corners));
+    }
+  });
+}
+
+}  // namespace raysift::sampling

@@ -1,0 +1,30 @@
+#pragma once
+/// \file Launching rays through an abstract, thread-safe batch tracer: all of a set in parallel
+/// (threshold mode), or a priority-ordered queue in groups of 32 until a deadline (budget mode, RP
+/// paper sections 5 and 7.6). The tracer interface lets tests use mock tracers of known cost.
+#include <cstdint>
+#include <functional>
+
+#include "core/image.h"
+#include "core/span.h"
+#include "core/timer.h"
+
+namespace raysift::sampling {
+
+/// Traces the pixels `pixels` (indices y*width + x) and writes each one's premultiplied RGBA to the
+/// same position of `out` (same length). Called concurrently from several threads with disjoint pixels.
+using TraceBatch = std::function<void(Span<const std::uint32_t> pixels, Span<Rgba> out)>;
+
+/// Rays handed to a worker at a time (RP paper section 7.6).
+inline constexpr std::size_t kRayGroup = 32;
+
+/// Traces every pixel of `pixels` in parallel groups of kRayGroup and stores the results in `image`.
+void trace_all(Span<const std::uint32_t> pixels, const TraceBatch& trace, ImageRGBA& image);
+
+/// \brief Traces `queue` from its start in groups of kRayGroup, in order, on all worker threads, and
+/// stops launching new groups once `clock` passes `deadline_ms`. Groups are claimed in order, so the
+/// traced rays are always a prefix of the queue. \return the length of that prefix.
+std::size_t trace_until(Span<const std::uint32_t> queue, const TraceBatch& trace, ImageRGBA& image, const Timer& clock,
+                        double deadline_ms);
+
+}  // namespace raysift::sampling
