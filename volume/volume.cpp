@@ -95,16 +95,16 @@ Vec3d Volume::voxel_size() const {
 
 float Volume::background() const { return impl_->grid->background(); }
 
-GridInfo Volume::info() const {
-  const openvdb::FloatGrid& g = *impl_->grid;
+namespace detail {
+GridInfo grid_base_info(const openvdb::GridBase& g) {
   GridInfo info;
   info.name = g.getName();
   info.type = g.valueType();
   const auto cls = g.getGridClass();
   info.grid_class = cls == openvdb::GRID_LEVEL_SET ? "level set" : cls == openvdb::GRID_FOG_VOLUME ? "fog volume" : "unknown";
-  info.active_voxels = g.tree().activeVoxelCount();
-  info.voxel_size = voxel_size();
-  info.background = g.background();
+  info.active_voxels = g.activeVoxelCount();
+  const openvdb::Vec3d vs = g.voxelSize();
+  info.voxel_size = {vs.x(), vs.y(), vs.z()};
   if (info.active_voxels == 0) return info;
   const openvdb::CoordBBox box = g.evalActiveVoxelBoundingBox();
   info.index_min = {box.min().x(), box.min().y(), box.min().z()};
@@ -119,6 +119,15 @@ GridInfo Volume::info() const {
   }
   info.bbox_min = world.min;
   info.bbox_max = world.max;
+  return info;
+}
+}  // namespace detail
+
+GridInfo Volume::info() const {
+  const openvdb::FloatGrid& g = *impl_->grid;
+  GridInfo info = detail::grid_base_info(g);
+  info.background = g.background();
+  if (info.active_voxels == 0) return info;
   const openvdb::math::MinMax<float> range = openvdb::tools::minMax(g.tree());
   info.value_min = range.min();
   info.value_max = range.max();

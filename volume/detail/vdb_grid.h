@@ -13,6 +13,8 @@ struct Volume::Impl {
 namespace detail {
 /// Calls openvdb::initialize() once, thread-safely.
 void ensure_openvdb_initialized();
+/// Name, type, class, active count, bboxes and voxel size of any grid (value range and background stay 0).
+GridInfo grid_base_info(const openvdb::GridBase& grid);
 }  // namespace detail
 
 }  // namespace raysift::volume

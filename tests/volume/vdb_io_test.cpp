@@ -1,0 +1,140 @@
+#include "volume/vdb_io.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "core/errors.h"
+#include "core/file_util.h"
+#include "tests/support/test_support.h"
+#include "volume/generate.h"
+
+namespace raysift::volume {
+namespace {
+
+const std::string kMixed = std::string(RAYSIFT_SOURCE_DIR) + "/tests/volume/data/mixed_grids.vdb";
+
+Volume small_ball() {
+  BallOptions o;
+  o.grid.dims = {20, 18, 16};
+  o.grid.voxel_size = 0.25;
+  o.grid.name = "ball";
+  o.radius_voxels = 6.3;
+  o.density = 0.8f;
+  return make_ball(o);
+}
+
+/// Runs `f`, expects exception E, and returns its message.
+template <typename E, typename F>
+std::string message_of(F&& f) {
+  try {
+    f();
+  } catch (const E& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected exception not thrown";
+  return "";
+}
+
+TEST(VdbIo, SaveLoadRoundTripKeepsValuesTransformAndName) {
+  const std::string path = test::make_temp_dir("vdb_rt") + "/ball.vdb";
+  const Volume ball = small_ball();
+  save_vdb(path, ball);
+  const Volume back = load_vdb(path);
+  EXPECT_EQ(back.name(), "ball");
+  EXPECT_EQ(back.active_voxel_count(), ball.active_voxel_count());
+  EXPECT_EQ(back.voxel_size(), Vec3d(0.25, 0.25, 0.25));
+  for (int k = 0; k < 16; ++k)
+    for (int j = 0; j < 18; ++j)
+      for (int i = 0; i < 20; ++i) ASSERT_EQ(back.value_at({i, j, k}), ball.value_at({i, j, k}));
+  EXPECT_EQ(load_vdb(path, "ball").active_voxel_count(), ball.active_voxel_count());
+}
+
+TEST(VdbIo, HalfFloatSavingRoundsToHalfPrecision) {
+  const std::string path = test::make_temp_dir("vdb_half") + "/ball.vdb";
+  const Volume ball = small_ball();
+  save_vdb(path, ball, {/*half_float=*/true});
+  const Volume back = load_vdb(path);
+  // Half floats have an 11-bit significand: relative error <= 2^-11 for normal values.
+  for (int i = 0; i < 20; ++i) {
+    const float a = ball.value_at({i, 9, 8}), b = back.value_at({i, 9, 8});
+    EXPECT_NEAR(b, a, std::abs(a) * 0x1p-11 + 1e-7) << i;
+  }
+}
+
+TEST(VdbIo, MissingFileAndDirectoryAreIoErrorsNamingThePath) {
+  const std::string dir = test::make_temp_dir("vdb_missing");
+  const std::string missing = dir + "/nope.vdb";
+  EXPECT_NE(message_of<IoError>([&] { load_vdb(missing); }).find(missing), std::string::npos);
+  EXPECT_NE(message_of<IoError>([&] { load_vdb(dir); }).find("directory"), std::string::npos);
+  EXPECT_THROW(inspect_vdb(missing), IoError);
+}
+
+TEST(VdbIo, TruncatedOrGarbageFileIsIoError) {
+  const std::string dir = test::make_temp_dir("vdb_trunc");
+  const std::string full = dir + "/full.vdb";
+  save_vdb(full, small_ball());
+  const std::string bytes = read_file_bytes(full);
+  // Cut inside the header, inside the grid descriptor/metadata, inside the tree data, and the last byte.
+  for (const std::size_t keep : {std::size_t(0), std::size_t(7), std::size_t(60), bytes.size() / 3,
+                                 bytes.size() / 2, bytes.size() - 1}) {
+    const std::string cut = dir + "/cut" + std::to_string(keep) + ".vdb";
+    std::ofstream(cut, std::ios::binary).write(bytes.data(), std::streamsize(keep));
+    const std::string msg = message_of<IoError>([&] { load_vdb(cut); });
+    EXPECT_NE(msg.find(cut), std::string::npos) << "kept " << keep << " bytes: " << msg;
+    EXPECT_THROW(inspect_vdb(cut), IoError) << keep;
+  }
+  const std::string text = dir + "/text.vdb";
+  std::ofstream(text) << "this is not a vdb file\n";
+  EXPECT_THROW(load_vdb(text), IoError);
+}
+
+TEST(VdbIo, UnknownGridListsAvailableGrids) {
+  const std::string msg = message_of<InvalidInput>([&] { load_vdb(kMixed, "pressure"); });
+  EXPECT_NE(msg.find("'pressure'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("'density' (float)"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("'velocity' (vec3s)"), std::string::npos) << msg;
+}
+
+TEST(VdbIo, NonFloatGridNamesItsType) {
+  const std::string msg = message_of<InvalidInput>([&] { load_vdb(kMixed, "labels"); });
+  EXPECT_NE(msg.find("int32"), std::string::npos) << msg;
+}
+
+TEST(VdbIo, EmptyGridRejectedUnlessAllowed) {
+  // The first float grid in the fixture is 'empty'.
+  const std::string msg = message_of<InvalidInput>([&] { load_vdb(kMixed); });
+  EXPECT_NE(msg.find("'empty'"), std::string::npos) << msg;
+  EXPECT_TRUE(load_vdb(kMixed, "empty", EmptyGrid::Allow).is_empty());
+  const Volume density = load_vdb(kMixed, "density");
+  EXPECT_EQ(density.active_voxel_count(), 2u);
+  EXPECT_FLOAT_EQ(density.value_at({5, 6, 7}), 0.75f);
+}
+
+TEST(VdbIo, InspectListsEveryGridWithTypeAndStats) {
+  const std::vector<GridInfo> grids = inspect_vdb(kMixed);
+  ASSERT_EQ(grids.size(), 4u);
+  EXPECT_EQ(grids[0].name, "velocity");
+  EXPECT_EQ(grids[0].type, "vec3s");
+  EXPECT_EQ(grids[0].active_voxels, 1u);
+  EXPECT_EQ(grids[1].type, "int32");
+  EXPECT_EQ(grids[2].active_voxels, 0u);
+  const GridInfo& d = grids[3];
+  EXPECT_EQ(d.type, "float");
+  EXPECT_EQ(d.active_voxels, 2u);
+  EXPECT_DOUBLE_EQ(d.value_min, 0.25);
+  EXPECT_DOUBLE_EQ(d.value_max, 0.75);
+  EXPECT_EQ(d.index_min, Vec3i(2, 3, 4));
+  EXPECT_EQ(d.bbox_max, Vec3d(2.5, 3.0, 3.5));  // (5,6,7) * 0.5
+}
+
+TEST(VdbIo, SaveIsAtomicOnFailure) {
+  const std::string dir = test::make_temp_dir("vdb_save_fail");
+  EXPECT_THROW(save_vdb(dir + "/no_such_folder/out.vdb", small_ball()), IoError);
+  EXPECT_THROW(save_vdb(dir, small_ball()), IoError);
+  EXPECT_TRUE(std::filesystem::is_empty(dir));
+}
+
+}  // namespace
+}  // namespace raysift::volume
