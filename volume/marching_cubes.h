@@ -1,0 +1,42 @@
+#pragma once
+/// \file Sparse, parallel marching cubes (Lorensen & Cline 1987) over an OpenVDB-backed Volume.
+/// Only the leaf blocks that hold active voxels (plus the blocks one voxel below them, whose cells touch
+/// active voxels) are visited, never the dense bounding box. Inactive voxels read as the grid's background
+/// value, so a surface that leaves the active region is still closed. Each 8³ block finds its own cut edges
+/// and triangles independently; the blocks are concatenated in sorted order and a cut edge's vertex is
+/// owned by the block holding its lower end point, so the output is bit-identical for any thread count and
+/// every cut grid edge yields exactly one shared vertex (watertight, consistently oriented).
+#include <vector>
+
+#include "core/span.h"
+#include "mesh/tri_mesh.h"
+#include "volume/volume.h"
+
+namespace raysift::volume {
+
+/// Fraction of a voxel edge kept between a vertex and a grid point (see extract_isosurface()).
+inline constexpr double kEdgeClamp = 0.01;
+
+struct MarchingCubesOptions {
+  /// Default: triangles are counter-clockwise seen from the side with values below the iso-value, i.e.
+  /// normals point toward decreasing values (out of dense material). True reverses every triangle.
+  bool flip_orientation = false;
+  bool threaded = true;  ///< false = serial path (same output)
+};
+
+/// Extracts the iso-surface {f = iso} with the inside predicate f >= iso (strict on one side). Vertices sit
+/// on cut grid edges at t = (iso − f0) / (f1 − f0) from the lower end point, clamped to
+/// [kEdgeClamp, 1 − kEdgeClamp]: voxels exactly equal to the iso-value (common for integer data) then never
+/// produce coincident vertices or zero-area triangles, and positions move by at most 0.01 voxel.
+/// Positions are in world space (the grid's index-to-world transform). A closed surface comes out as a
+/// closed, consistently oriented 2-manifold. NaN voxels count as outside.
+/// \param iso the iso-value, finite. An iso-value outside the data range yields an empty mesh.
+/// \throw InvalidInput if iso is not finite or the volume has no active voxels.
+mesh::TriMesh extract_isosurface(const Volume& volume, double iso, const MarchingCubesOptions& options = {});
+
+/// One surface per iso-value, in the given order; each is extracted on its own (separate meshes).
+/// \throw InvalidInput as extract_isosurface().
+std::vector<mesh::TriMesh> extract_isosurfaces(const Volume& volume, Span<const double> iso_values,
+                                               const MarchingCubesOptions& options = {});
+
+}  // namespace raysift::volume
