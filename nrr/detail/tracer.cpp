@@ -1,0 +1,214 @@
+#include "nrr/detail/tracer.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/errors.h"
+
+namespace raysift::nrr::detail {
+namespace {
+
+/// Relative shortening of the eye -> sample segment in visibility tests, so that the sample's own
+/// triangle (at parameter 1) is not its own occluder (ALGORITHMS.md §10/§9 choice epsilon_r = 1e-4).
+constexpr float kVisibilitySegmentEpsilon = 1e-4f;
+/// Two peel/visibility candidates closer than this (relative to t) on different triangles are the
+/// same surface point hit on a shared edge; one of them is dropped (ALGORITHMS.md §10).
+constexpr float kSameHitRelative = 1e-6f;
+constexpr int kTile = 16;
+constexpr int kBlock = 4;
+
+struct Candidate {
+  float t;
+  mesh::TriangleId id;
+  float u, v;
+  bool operator<(const Candidate& o) const { return t < o.t || (t == o.t && id < o.id); }
+};
+
+mesh::Hit to_hit(const SampledScene& scene, const Candidate& c) {
+  mesh::Hit h;
+  h.t = c.t;
+  h.triangle_id = c.id;
+  h.normal_ws = Vec3f(scene.face_normal(c.id));
+  h.u = c.u;
+  h.v = c.v;
+  return h;
+}
+
+Candidate to_candidate(const mesh::HitCandidate& c) { return {c.t, c.triangle_id, c.u, c.v}; }
+
+/// Inserts `c` into the sorted list of at most k distinct hits. Duplicate reports of one triangle are
+/// dropped; two triangles hit at the same point (a shared edge) keep the smaller id, so the result
+/// does not depend on the order in which Embree reports candidates.
+void insert_distinct(std::vector<Candidate>& list, const Candidate& c, std::size_t k) {
+  for (Candidate& e : list) {
+    if (e.id == c.id) return;
+    if (std::abs(e.t - c.t) <= kSameHitRelative * std::max(e.t, c.t)) {
+      if (c.id < e.id) e = c;
+      std::sort(list.begin(), list.end());
+      return;
+    }
+  }
+  if (list.size() == k && !(c < list.back())) return;
+  list.insert(std::upper_bound(list.begin(), list.end(), c), c);
+  if (list.size() > k) list.pop_back();
+}
+
+}  // namespace
+
+bool pixel_captured(const DepthImage& image, const Camera& camera, const Vec3f& x, mesh::TriangleId id) {
+  const auto p = camera.project(Vec3d(x));
+  if (!p || !(p->x_ss >= 0.0 && p->x_ss < image.width && p->y_ss >= 0.0 && p->y_ss < image.height)) return false;
+  const std::size_t pixel = std::size_t(p->y_ss) * std::size_t(image.width) + std::size_t(p->x_ss);
+  return image.triangle_id[pixel] == id;
+}
+
+bool may_be_visible_from(const SampledScene& scene, const Camera& camera, const Vec3f& x, mesh::TriangleId id) {
+  const Vec3d to_x = Vec3d(x) - camera.eye();
+  if (!(dot(scene.face_normal(id), to_x) < 0.0)) return false;
+  const auto p = camera.project(Vec3d(x));
+  return p && p->x_ss >= 0.0 && p->x_ss < camera.width() && p->y_ss >= 0.0 && p->y_ss < camera.height();
+}
+
+bool visible_from(const SampledScene& scene, const Camera& camera, const Vec3f& x, mesh::TriangleId id) {
+  if (!may_be_visible_from(scene, camera, x, id)) return false;
+  const Vec3f eye(camera.eye());
+  // Back faces do not occlude: the image from `camera` culls them, so they cannot hide x in it.
+  mesh::QueryOptions cull;
+  cull.cull_back_faces = true;
+  return !scene.rays().occluded({eye, x - eye, 0.0f, 1.0f - kVisibilitySegmentEpsilon}, cull);
+}
+
+void trace(const SampledScene& scene, const ImageRule& rule, Span<const mesh::RayF> rays, Span<mesh::Hit> hits,
+           bool is_coherent) {
+  mesh::QueryOptions options;
+  options.cull_back_faces = true;
+  options.is_coherent = is_coherent;
+  switch (rule.mode) {
+    case SamplingMode::Conventional:
+      scene.rays().intersect(rays, hits, options);
+      return;
+    case SamplingMode::NrrPixel: {
+      if (rule.previous.empty()) {
+        scene.rays().intersect(rays, hits, options);
+        return;
+      }
+      const mesh::HitFilter keep_non_redundant = [&](const mesh::HitCandidate& c) {
+        const Vec3f x = sample_position(rays[c.ray_index], c.t);
+        for (std::size_t j = 0; j < rule.previous.size(); ++j)
+          if (pixel_captured(rule.previous[j], rule.previous_cameras[j], x, c.triangle_id)) return false;
+        return true;
+      };
+      options.filter = &keep_non_redundant;
+      scene.rays().intersect(rays, hits, options);
+      return;
+    }
+    case SamplingMode::NrrVisibility: {
+      if (rule.previous_cameras.empty()) {
+        scene.rays().intersect(rays, hits, options);
+        return;
+      }
+      // A candidate outside every earlier frustum, or facing away from every earlier eye, is surely
+      // non-redundant and is accepted at once (pruning the traversal); the others are collected and
+      // tested with occlusion rays after the traversal, nearest first.
+      std::vector<std::vector<Candidate>> maybe(rays.size());
+      const mesh::HitFilter collect = [&](const mesh::HitCandidate& c) {
+        const Vec3f x = sample_position(rays[c.ray_index], c.t);
+        for (const Camera& cam : rule.previous_cameras)
+          if (may_be_visible_from(scene, cam, x, c.triangle_id)) {
+            maybe[c.ray_index].push_back(to_candidate(c));
+            return false;
+          }
+        return true;
+      };
+      options.filter = &collect;
+      scene.rays().intersect(rays, hits, options);
+      for (std::size_t i = 0; i < rays.size(); ++i) {
+        std::vector<Candidate>& list = maybe[i];
+        std::sort(list.begin(), list.end());
+        list.erase(std::unique(list.begin(), list.end(),
+                               [](const Candidate& a, const Candidate& b) { return a.id == b.id; }),
+                   list.end());
+        for (const Candidate& c : list) {
+          if (!(c.t < hits[i].t)) break;
+          const Vec3f x = sample_position(rays[i], c.t);
+          const bool is_redundant = std::any_of(rule.previous_cameras.begin(), rule.previous_cameras.end(),
+                                                [&](const Camera& cam) { return visible_from(scene, cam, x, c.id); });
+          if (!is_redundant) {
+            hits[i] = to_hit(scene, c);
+            break;
+          }
+        }
+      }
+      return;
+    }
+    case SamplingMode::Peel: {
+      std::vector<mesh::Hit> layers(rays.size() * std::size_t(rule.layer + 1));
+      trace_layers(scene, rule.layer + 1, rays, Span<mesh::Hit>(layers), is_coherent);
+      std::copy(layers.begin() + std::ptrdiff_t(rays.size()) * rule.layer, layers.end(), hits.begin());
+      return;
+    }
+  }
+}
+
+void trace_layers(const SampledScene& scene, int k, Span<const mesh::RayF> rays, Span<mesh::Hit> layers,
+                  bool is_coherent) {
+  RAYSIFT_CHECK_OP(layers.size(), ==, rays.size() * std::size_t(k));
+  std::vector<std::vector<Candidate>> nearest(rays.size());
+  const mesh::HitFilter collect = [&](const mesh::HitCandidate& c) {
+    insert_distinct(nearest[c.ray_index], to_candidate(c), std::size_t(k));
+    return false;  // reject everything: the traversal then visits every front-facing hit once
+  };
+  mesh::QueryOptions options;
+  options.cull_back_faces = true;
+  options.is_coherent = is_coherent;
+  options.filter = &collect;
+  std::vector<mesh::Hit> ignored(rays.size());
+  scene.rays().intersect(rays, Span<mesh::Hit>(ignored), options);
+  for (std::size_t i = 0; i < rays.size(); ++i)
+    for (std::size_t l = 0; l < std::size_t(k); ++l)
+      layers[l * rays.size() + i] = l < nearest[i].size() ? to_hit(scene, nearest[i][l]) : mesh::Hit{};
+}
+
+void for_each_tile(const Camera& camera, bool threaded,
+                   const std::function<void(Span<const mesh::RayF> rays, Span<const std::size_t> pixels)>& fn) {
+  const int w = camera.width(), h = camera.height();
+  const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
+  const Vec3f eye(camera.eye());
+  const auto run = [&](int tile) {
+    std::vector<mesh::RayF> rays;
+    std::vector<std::size_t> pixels;
+    rays.reserve(kTile * kTile);
+    pixels.reserve(kTile * kTile);
+    const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
+    for (int by = y0; by < std::min(y0 + kTile, h); by += kBlock)
+      for (int bx = x0; bx < std::min(x0 + kTile, w); bx += kBlock)
+        for (int y = by; y < std::min(by + kBlock, h); ++y)
+          for (int x = bx; x < std::min(bx + kBlock, w); ++x) {
+            rays.push_back({eye, Vec3f(camera.direction_unit_depth(x + 0.5, y + 0.5))});
+            pixels.push_back(std::size_t(y) * std::size_t(w) + std::size_t(x));
+          }
+    fn(Span<const mesh::RayF>(rays), Span<const std::size_t>(pixels));
+  };
+  const int tiles = tiles_x * tiles_y;
+  if (!threaded) {
+    for (int t = 0; t < tiles; ++t) run(t);
+    return;
+  }
+  tbb::parallel_for(tbb::blocked_range<int>(0, tiles), [&](const tbb::blocked_range<int>& r) {
+    for (int t = r.begin(); t < r.end(); ++t) run(t);
+  });
+}
+
+void store_sample(const SampledScene& scene, const mesh::RayF& ray, const mesh::Hit& h, std::size_t pixel,
+                  DepthImage& image) {
+  if (!h.is_hit()) return;
+  image.depth[pixel] = h.t;
+  image.triangle_id[pixel] = h.triangle_id;
+  image.normal_ws[pixel] = scene.shading_normal(h.triangle_id, h.u, h.v);
+  image.position_ws[pixel] = sample_position(ray, h.t);
+}
+
+}  // namespace raysift::nrr::detail

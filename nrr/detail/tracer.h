@@ -1,0 +1,54 @@
+#pragma once
+/// \file Internal to nrr/: the per-ray sampling rules shared by the samplers and the metrics, and the
+/// two redundancy predicates. A rule answers "which sample would this image hold along this ray", for
+/// camera rays (rendering) and for arbitrary rays (visibility availability in the metrics).
+#include <functional>
+#include <vector>
+
+#include "nrr/sampler.h"
+
+namespace raysift::nrr::detail {
+
+/// The sample point of a hit along a ray, rounded to float exactly once so that the samplers and the
+/// metrics reproject the very same point.
+inline Vec3f sample_position(const mesh::RayF& ray, float t) {
+  return Vec3f(Vec3d(ray.origin) + Vec3d(ray.direction) * double(t));
+}
+
+/// Pixel (Alg. 3): `x` projects inside `image` onto a pixel holding triangle `id`.
+bool pixel_captured(const DepthImage& image, const Camera& camera, const Vec3f& x, mesh::TriangleId id);
+
+/// Visibility (Alg. 2, plus the frustum [choice] of ALGORITHMS.md §10): `x` on triangle `id` lies in
+/// the camera's image, its face looks at the eye, and the segment eye -> x is unoccluded by front faces.
+bool visible_from(const SampledScene& scene, const Camera& camera, const Vec3f& x, mesh::TriangleId id);
+/// The cheap part of visible_from (frustum and facing), usable inside a filter.
+bool may_be_visible_from(const SampledScene& scene, const Camera& camera, const Vec3f& x, mesh::TriangleId id);
+
+/// How one image picks its sample along a ray.
+struct ImageRule {
+  SamplingMode mode = SamplingMode::Conventional;
+  Span<const DepthImage> previous;  ///< nrr-pixel: the images before this one
+  Span<const Camera> previous_cameras;  ///< nrr-pixel and nrr-visibility: their cameras
+  int layer = 0;                    ///< peel: 0 = nearest front face
+};
+
+/// hits[i] = the sample `rule` keeps along rays[i] (a miss if none). Serial.
+void trace(const SampledScene& scene, const ImageRule& rule, Span<const mesh::RayF> rays, Span<mesh::Hit> hits,
+           bool is_coherent);
+
+/// Depth peeling in one traversal: layers[l * rays.size() + i] = the l-th nearest distinct front-facing
+/// hit along rays[i], l < k. Serial.
+void trace_layers(const SampledScene& scene, int k, Span<const mesh::RayF> rays, Span<mesh::Hit> layers,
+                  bool is_coherent);
+
+/// Calls fn(rays, pixels) for tiles of 16x16 pixels whose rays are ordered in 4x4 blocks (one packet
+/// each); rays have direction camera.direction_unit_depth, so t is view depth. Tiles run in parallel
+/// when `threaded`; each tile writes only its own pixels.
+void for_each_tile(const Camera& camera, bool threaded,
+                   const std::function<void(Span<const mesh::RayF> rays, Span<const std::size_t> pixels)>& fn);
+
+/// Stores hit `h` of `ray` at `pixel` of `image` (shading normal, position, depth = t).
+void store_sample(const SampledScene& scene, const mesh::RayF& ray, const mesh::Hit& h, std::size_t pixel,
+                  DepthImage& image);
+
+}  // namespace raysift::nrr::detail

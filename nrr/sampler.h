@@ -1,0 +1,69 @@
+#pragma once
+/// \file Multi-view depth images of a triangle scene: conventional images, non-redundant rendering
+/// (Xie, Wang & Popescu 2016, Alg. 1 with pixel redundancy, Alg. 3, or visibility redundancy, Alg. 2)
+/// and depth peeling. Key decision: every mode is ray casting with Embree where a redundant or
+/// back-facing candidate is rejected inside traversal and the ray continues, so each pixel costs one
+/// traversal (ALGORITHMS.md §10). Visibility redundancy and peeling collect candidates during that
+/// traversal and test them afterwards, because no ray query may start inside a filter.
+#include <string>
+#include <vector>
+
+#include "core/camera.h"
+#include "core/span.h"
+#include "mesh/ray_scene.h"
+#include "mesh/tri_mesh.h"
+#include "nrr/depth_image.h"
+
+namespace raysift::nrr {
+
+enum class SamplingMode { Conventional, NrrPixel, NrrVisibility, Peel };
+
+/// "conventional", "nrr-pixel", "nrr-visibility", "peel". \throw InvalidInput for anything else.
+SamplingMode parse_sampling_mode(const std::string& name);
+std::string to_string(SamplingMode mode);
+
+/// A mesh prepared for sampling: its Embree scene, triangle normals and area-weighted vertex normals.
+/// @warning Immutable after construction; all queries are thread-safe.
+class SampledScene {
+ public:
+  /// \throw InvalidInput for an empty mesh, a NaN/Inf vertex or an out-of-range index.
+  explicit SampledScene(const mesh::TriMesh& mesh);
+
+  const mesh::RayScene& rays() const { return rays_; }
+  /// Unit normal of the CCW front face (zero for a degenerate triangle).
+  const Vec3d& face_normal(mesh::TriangleId id) const { return face_normals_[mesh::triangle_id_index(id)]; }
+  /// Interpolated vertex normal at barycentrics (u, v); the face normal where that is zero or faces
+  /// the other way (e.g. a crease shared by the two sides of a thin sheet).
+  Vec3f shading_normal(mesh::TriangleId id, float u, float v) const;
+  /// Scene bounding-box diagonal, world units.
+  double diagonal() const { return rays_.bounds().diagonal(); }
+  /// Mean triangle edge length, world units (for the triangle-size / pixel-size ratio in reports).
+  double mean_edge_length() const { return mean_edge_; }
+
+ private:
+  mesh::RayScene rays_;
+  std::vector<std::array<std::uint32_t, 3>> triangles_;
+  std::vector<Vec3d> face_normals_;
+  std::vector<Vec3f> vertex_normals_;
+  double mean_edge_ = 0.0;
+};
+
+struct SamplingOptions {
+  SamplingMode mode = SamplingMode::NrrPixel;
+  int peel_layers = 0;  ///< peel only: number of layers, 0 = as many as views
+  bool threaded = true; ///< false renders serially (same result; for bisecting bugs)
+};
+
+/// Renders one depth image per view (per layer for peel, all from peel_camera(views)). All modes
+/// cull back faces. Image 0 of the NRR modes equals the conventional image 0 bit for bit.
+/// Coincident eyes are allowed: with pixel redundancy NRR image 1 from the eye of image 0 is the
+/// second depth-peeling layer.
+/// \throw InvalidInput if `views` is empty, a camera is invalid, or peel_layers < 0.
+std::vector<DepthImage> render_depth_images(const SampledScene& scene, Span<const CameraSpec> views,
+                                            const SamplingOptions& options = {});
+
+/// Depth peeling's view: eye and target at the centroids of the views' eyes and targets; up, field
+/// of view and size of views[0]. \throw InvalidInput if `views` is empty.
+CameraSpec peel_camera(Span<const CameraSpec> views);
+
+}  // namespace raysift::nrr
