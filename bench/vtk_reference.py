@@ -1,0 +1,108 @@
+#!/usr/bin/python3
+"""VTK reference timings for bench/marching_cubes_bench and bench/mesh_prep_bench (bench only).
+
+Run with Debian's interpreter (/usr/bin/python3, package python3-vtk9). Each mode prints one line
+"ms=<median wall ms> triangles=<output triangles> ..." that the C++ benches parse.
+
+  vtk_reference.py flying-edges RAW[.gz] NX NY NZ u8|f32 ISO RUNS
+  vtk_reference.py windowed-sinc MESH.ply ITERATIONS RUNS
+  vtk_reference.py quadric-decimation MESH.ply TARGET_TRIANGLES RUNS
+"""
+import gzip
+import os
+import shutil
+import statistics
+import sys
+import tempfile
+import time
+
+import vtk
+
+
+def timed(algorithm, runs):
+    times = []
+    for _ in range(runs):
+        algorithm.Modified()
+        start = time.perf_counter()
+        algorithm.Update()
+        times.append((time.perf_counter() - start) * 1e3)
+    return statistics.median(times)
+
+
+def flying_edges(path, nx, ny, nz, dtype, iso, runs):
+    tmp = None
+    if path.endswith(".gz"):
+        tmp = tempfile.NamedTemporaryFile(suffix=".raw", delete=False)
+        with gzip.open(path, "rb") as src:
+            shutil.copyfileobj(src, tmp)
+        tmp.close()
+        path = tmp.name
+    reader = vtk.vtkImageReader2()
+    reader.SetFileName(path)
+    reader.SetFileDimensionality(3)
+    reader.SetDataExtent(0, nx - 1, 0, ny - 1, 0, nz - 1)
+    reader.SetDataByteOrderToLittleEndian()
+    if dtype == "u8":
+        reader.SetDataScalarTypeToUnsignedChar()
+    else:
+        reader.SetDataScalarTypeToFloat()
+    reader.Update()
+    fe = vtk.vtkFlyingEdges3D()
+    fe.SetInputConnection(reader.GetOutputPort())
+    fe.SetValue(0, iso)
+    fe.ComputeNormalsOff()
+    fe.ComputeGradientsOff()
+    fe.ComputeScalarsOff()
+    ms = timed(fe, runs)
+    if tmp:
+        os.unlink(tmp.name)
+    print(f"ms={ms:.3f} triangles={fe.GetOutput().GetNumberOfCells()} "
+          f"threads={vtk.vtkSMPTools.GetEstimatedNumberOfThreads()}")
+
+
+def read_ply(path):
+    reader = vtk.vtkPLYReader()
+    reader.SetFileName(path)
+    reader.Update()
+    return reader
+
+
+def windowed_sinc(path, iterations, runs):
+    reader = read_ply(path)
+    smoother = vtk.vtkWindowedSincPolyDataFilter()
+    smoother.SetInputConnection(reader.GetOutputPort())
+    smoother.SetNumberOfIterations(iterations)
+    smoother.BoundarySmoothingOff()
+    smoother.FeatureEdgeSmoothingOff()
+    smoother.NonManifoldSmoothingOff()
+    smoother.SetPassBand(0.1)
+    ms = timed(smoother, runs)
+    vertices = reader.GetOutput().GetNumberOfPoints()
+    print(f"ms={ms:.3f} triangles={smoother.GetOutput().GetNumberOfCells()} vertices={vertices} "
+          f"vertex_iterations_per_s={vertices * iterations / (ms * 1e-3):.4g}")
+
+
+def quadric_decimation(path, target, runs):
+    reader = read_ply(path)
+    faces = reader.GetOutput().GetNumberOfCells()
+    decimate = vtk.vtkQuadricDecimation()
+    decimate.SetInputConnection(reader.GetOutputPort())
+    decimate.SetTargetReduction(1.0 - target / faces)
+    ms = timed(decimate, runs)
+    print(f"ms={ms:.3f} triangles={decimate.GetOutput().GetNumberOfCells()} input_triangles={faces}")
+
+
+def main(argv):
+    mode = argv[1] if len(argv) > 1 else ""
+    if mode == "flying-edges" and len(argv) == 9:
+        flying_edges(argv[2], int(argv[3]), int(argv[4]), int(argv[5]), argv[6], float(argv[7]), int(argv[8]))
+    elif mode == "windowed-sinc" and len(argv) == 5:
+        windowed_sinc(argv[2], int(argv[3]), int(argv[4]))
+    elif mode == "quadric-decimation" and len(argv) == 5:
+        quadric_decimation(argv[2], int(argv[3]), int(argv[4]))
+    else:
+        sys.exit(__doc__)
+
+
+if __name__ == "__main__":
+    main(sys.argv)
