@@ -47,31 +47,12 @@ struct VertexFaces {
 
 }  // namespace
 
-MeshAnalysis analyze_mesh(const TriMesh& mesh) {
-  MeshAnalysis a;
-  a.vertices = mesh.vertex_count();
-  a.faces = mesh.triangle_count();
-  const VertexFaces vf(mesh);
-
-  std::size_t used_vertices = 0;
-  for (std::size_t v = 0; v < a.vertices; ++v) {
-    if (vf.offsets[v] == vf.offsets[v + 1]) {
-      ++a.isolated_vertices;
-      continue;
-    }
-    ++used_vertices;
-    a.bbox.expand(Vec3d(mesh.positions[v]));
-  }
-
-  for (const Tri& t : mesh.triangles) {
-    const Vec3d p0(mesh.positions[t[0]]), p1(mesh.positions[t[1]]), p2(mesh.positions[t[2]]);
-    const Vec3d c = cross(p1 - p0, p2 - p0);
-    const double area = 0.5 * length(c);
-    a.area += area;
-    a.signed_volume += dot(p0, cross(p1, p2)) / 6.0;
-    if (has_repeated_index(t) || area == 0.0) ++a.degenerate_faces;
-  }
-
+/// Edge and fan counts into `a` and the kind of every vertex into `kinds`.
+void scan_topology(const TriMesh& mesh, const VertexFaces& vf, MeshAnalysis& a, std::vector<VertexKind>& kinds) {
+  kinds.assign(mesh.vertex_count(), VertexKind::Isolated);
+  auto mark = [&kinds](std::uint32_t v, VertexKind k) {
+    if (kinds[v] < k) kinds[v] = k;  // NonManifold > Boundary > Interior
+  };
   // Edges: for every vertex v, the sides (v, w) with w > v among its incident triangles. Each side
   // records its direction (+1 if the triangle runs v -> w) so orientation consistency can be checked.
   struct Side {
@@ -98,6 +79,9 @@ MeshAnalysis analyze_mesh(const TriMesh& mesh) {
       while (j < sides.size() && sides[j].other == sides[i].other) direction_sum += sides[j++].direction;
       const std::size_t count = j - i;
       ++a.edges;
+      const VertexKind kind = count == 1 ? VertexKind::Boundary : (count > 2 ? VertexKind::NonManifold : VertexKind::Interior);
+      mark(v, kind);
+      mark(sides[i].other, kind);
       if (count == 1) ++a.boundary_edges;
       if (count > 2) ++a.non_manifold_edges;
       if (count == 2 && direction_sum != 0) ++a.inconsistent_edges;
@@ -127,12 +111,50 @@ MeshAnalysis analyze_mesh(const TriMesh& mesh) {
     std::size_t fans = 0;
     for (std::uint32_t i = 0; i < n; ++i)
       if (!has_repeated_index(mesh.triangles[vf.faces[begin + i]]) && find(i) == i) ++fans;
-    if (valid > 0 && fans > 1) ++a.non_manifold_vertices;
+    if (valid > 0 && fans > 1) mark(v, VertexKind::NonManifold);
+  }
+  // Counted after the loop: a vertex also becomes non-manifold through an edge found at a lower vertex.
+  a.non_manifold_vertices = std::size_t(std::count(kinds.begin(), kinds.end(), VertexKind::NonManifold));
+}
+
+MeshAnalysis analyze_mesh(const TriMesh& mesh) {
+  MeshAnalysis a;
+  a.vertices = mesh.vertex_count();
+  a.faces = mesh.triangle_count();
+  const VertexFaces vf(mesh);
+
+  std::size_t used_vertices = 0;
+  for (std::size_t v = 0; v < a.vertices; ++v) {
+    if (vf.offsets[v] == vf.offsets[v + 1]) {
+      ++a.isolated_vertices;
+      continue;
+    }
+    ++used_vertices;
+    a.bbox.expand(Vec3d(mesh.positions[v]));
   }
 
+  for (const Tri& t : mesh.triangles) {
+    const Vec3d p0(mesh.positions[t[0]]), p1(mesh.positions[t[1]]), p2(mesh.positions[t[2]]);
+    const Vec3d c = cross(p1 - p0, p2 - p0);
+    const double area = 0.5 * length(c);
+    a.area += area;
+    a.signed_volume += dot(p0, cross(p1, p2)) / 6.0;
+    if (has_repeated_index(t) || area == 0.0) ++a.degenerate_faces;
+  }
+
+  std::vector<VertexKind> kinds;
+  scan_topology(mesh, vf, a, kinds);
   a.components = label_components(mesh).count;
   a.euler_characteristic = std::int64_t(used_vertices) - std::int64_t(a.edges) + std::int64_t(a.faces);
   return a;
+}
+
+std::vector<VertexKind> classify_vertices(const TriMesh& mesh) {
+  MeshAnalysis a;
+  a.vertices = mesh.vertex_count();
+  std::vector<VertexKind> kinds;
+  scan_topology(mesh, VertexFaces(mesh), a, kinds);
+  return kinds;
 }
 
 ComponentLabels label_components(const TriMesh& mesh) {

@@ -20,7 +20,9 @@ struct MeshAnalysis {
   std::size_t faces = 0;
   std::size_t boundary_edges = 0;        ///< in exactly one triangle
   std::size_t non_manifold_edges = 0;    ///< in three or more triangles
-  std::size_t non_manifold_vertices = 0; ///< incident triangles form more than one fan (e.g. two cones touching)
+  /// Incident triangles form more than one fan (two cones touching at a tip), or the vertex lies on a
+  /// non-manifold edge.
+  std::size_t non_manifold_vertices = 0;
   std::size_t inconsistent_edges = 0;    ///< two-triangle edges whose triangles traverse it in the same direction
   std::size_t degenerate_faces = 0;      ///< repeated index or exactly zero area
   std::size_t components = 0;            ///< connected components (triangles linked through shared vertices)
@@ -42,6 +44,17 @@ struct MeshAnalysis {
 
 /// Analyses `mesh`. O(V + F) time and memory. \pre every index < vertex_count() (validate_mesh()).
 MeshAnalysis analyze_mesh(const TriMesh& mesh);
+
+/// Role of a vertex in the mesh's connectivity (degenerate triangles with a repeated index are ignored).
+enum class VertexKind : std::uint8_t {
+  Isolated,     ///< in no triangle
+  Interior,     ///< one closed fan of triangles, every incident edge in exactly two
+  Boundary,     ///< one fan, on at least one edge used by a single triangle
+  NonManifold,  ///< several fans, or on an edge used by three or more triangles
+};
+/// One kind per vertex; smoothing keeps boundary and non-manifold vertices fixed. O(V + F).
+/// \pre every index < vertex_count().
+std::vector<VertexKind> classify_vertices(const TriMesh& mesh);
 
 /// Connected components of the triangles (linked through shared vertices), numbered 0..count-1 in order of
 /// their first triangle, so the labelling is deterministic.

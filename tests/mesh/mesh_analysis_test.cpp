@@ -145,5 +145,25 @@ TEST(MeshAnalysis, DegenerateTrianglesAreCounted) {
   EXPECT_EQ(analyze_mesh(m).degenerate_faces, 2u);
 }
 
+TEST(MeshAnalysis, VertexKindsFollowTheTopology) {
+  TriMesh m = unit_cube();
+  m.triangles.pop_back();  // opens the z = 1 face: triangle (4, 7, 6) is gone
+  m.positions.push_back({5, 5, 5});
+  const std::vector<VertexKind> kinds = classify_vertices(m);
+  EXPECT_EQ(kinds[0], VertexKind::Interior);
+  EXPECT_EQ(kinds[4], VertexKind::Boundary);
+  EXPECT_EQ(kinds[6], VertexKind::Boundary);
+  EXPECT_EQ(kinds[7], VertexKind::Boundary);
+  EXPECT_EQ(kinds[8], VertexKind::Isolated);
+
+  TriMesh fin;
+  fin.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}};
+  fin.triangles = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}};
+  const std::vector<VertexKind> fin_kinds = classify_vertices(fin);
+  EXPECT_EQ(fin_kinds[0], VertexKind::NonManifold);
+  EXPECT_EQ(fin_kinds[1], VertexKind::NonManifold);
+  EXPECT_EQ(fin_kinds[2], VertexKind::Boundary);
+}
+
 }  // namespace
 }  // namespace raysift::mesh
