@@ -168,7 +168,10 @@ ImportanceBuffer compute_importance(const mesh::TriMesh& mesh, const mesh::MeshC
   t.lines_ms = timer.elapsed_ms();
 
   timer.reset();
-  const DepthBuffer depth = rasterize_depth(mesh, frame, {options.threaded});
+  // [choice] Hidden lines are removed at the buffer's resolution, not the frame's: the lines are drawn
+  // there anyway, and the same z-buffer then gives the background coverage of the mesh.
+  const DepthBuffer depth = rasterize_depth(mesh, Camera(scaled_camera(frame.spec(), options.scale)),
+                                            {options.threaded});
   VisibilityOptions vis = options.visibility;
   vis.classes = line_options.classes;
   vis.threaded = options.threaded;

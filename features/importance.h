@@ -68,7 +68,8 @@ struct ImportanceTimings {
 };
 
 /// The whole per-frame pipeline: extract lines (classes from `line_options`), remove hidden ones against a
-/// z-buffer of `mesh`, classify exterior silhouettes, rasterise. Curvature is view-independent and passed
+/// z-buffer of `mesh` at the buffer's resolution (which also gives the mesh's background coverage when
+/// `background.mesh == &mesh`), classify exterior silhouettes, rasterise. Curvature is view-independent and passed
 /// in. `visible_lines` and `timings`, when non-null, receive the intermediate results.
 /// \throw InvalidInput as extract_lines and rasterize_importance do.
 ImportanceBuffer compute_importance(const mesh::TriMesh& mesh, const mesh::MeshCurvature& curvature,

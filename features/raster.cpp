@@ -17,6 +17,7 @@ constexpr int kBandRows = 16;
 
 struct ScreenTri {
   double x[3], y[3], inv_z[3];
+  int r0, r1, c0, c1;  // rows and columns whose pixel centres the triangle's bounds span (inclusive)
   std::uint32_t face;
 };
 
@@ -102,34 +103,31 @@ DepthBuffer rasterize_depth(const mesh::TriMesh& mesh, const Camera& camera, con
           st.y[j] = (1.0 - corner[j]->y / corner[j]->z / tan_y) * 0.5 * height;
           st.inv_z[j] = 1.0 / corner[j]->z;
         }
-        parts[c].push_back(st);
+        // Pixel centres (i + 0.5) inside the bounds; triangles that cover none are dropped here.
+        const double x0 = std::min({st.x[0], st.x[1], st.x[2]}), x1 = std::max({st.x[0], st.x[1], st.x[2]});
+        const double y0 = std::min({st.y[0], st.y[1], st.y[2]}), y1 = std::max({st.y[0], st.y[1], st.y[2]});
+        st.c0 = int(std::max(0.0, std::ceil(x0 - 0.5)));
+        st.c1 = int(std::min(double(width - 1), std::floor(x1 - 0.5)));
+        st.r0 = int(std::max(0.0, std::ceil(y0 - 0.5)));
+        st.r1 = int(std::min(double(height - 1), std::floor(y1 - 0.5)));
+        if (st.c0 <= st.c1 && st.r0 <= st.r1) parts[c].push_back(st);
       }
     }
   });
   std::vector<ScreenTri> tris;
   for (auto& p : parts) tris.insert(tris.end(), p.begin(), p.end());
 
-  // Pixel rows whose centres (r + 0.5) a triangle spans; binned into bands of rows, in triangle order.
-  auto row_range = [&](const ScreenTri& st, int& r0, int& r1) {
-    const double y0 = std::min({st.y[0], st.y[1], st.y[2]}), y1 = std::max({st.y[0], st.y[1], st.y[2]});
-    r0 = int(std::max(0.0, std::ceil(y0 - 0.5)));
-    r1 = int(std::min(double(height - 1), std::floor(y1 - 0.5)));
-  };
+  // Bin the triangles into bands of rows, in triangle order.
   const int bands = (height + kBandRows - 1) / kBandRows;
   std::vector<std::uint32_t> band_offset(std::size_t(bands) + 1, 0);
-  for (const ScreenTri& st : tris) {
-    int r0, r1;
-    row_range(st, r0, r1);
-    for (int b = r0 / kBandRows; r0 <= r1 && b <= r1 / kBandRows; ++b) ++band_offset[std::size_t(b) + 1];
-  }
+  for (const ScreenTri& st : tris)
+    for (int b = st.r0 / kBandRows; b <= st.r1 / kBandRows; ++b) ++band_offset[std::size_t(b) + 1];
   for (int b = 0; b < bands; ++b) band_offset[std::size_t(b) + 1] += band_offset[std::size_t(b)];
   std::vector<std::uint32_t> band_tris(band_offset.back());
   std::vector<std::uint32_t> fill(band_offset.begin(), band_offset.end() - 1);
-  for (std::size_t i = 0; i < tris.size(); ++i) {
-    int r0, r1;
-    row_range(tris[i], r0, r1);
-    for (int b = r0 / kBandRows; r0 <= r1 && b <= r1 / kBandRows; ++b) band_tris[fill[std::size_t(b)]++] = std::uint32_t(i);
-  }
+  for (std::size_t i = 0; i < tris.size(); ++i)
+    for (int b = tris[i].r0 / kBandRows; b <= tris[i].r1 / kBandRows; ++b)
+      band_tris[fill[std::size_t(b)]++] = std::uint32_t(i);
 
   for_chunks(std::size_t(bands), 1, options.threaded, [&](std::size_t band, std::size_t, std::size_t) {
     const int band_r0 = int(band) * kBandRows, band_r1 = std::min(height - 1, band_r0 + kBandRows - 1);
@@ -137,24 +135,24 @@ DepthBuffer rasterize_depth(const mesh::TriMesh& mesh, const Camera& camera, con
       const ScreenTri& st = tris[band_tris[k]];
       const double area = (st.x[1] - st.x[0]) * (st.y[2] - st.y[0]) - (st.x[2] - st.x[0]) * (st.y[1] - st.y[0]);
       if (!(std::abs(area) > 1e-12)) continue;
-      int r0, r1;
-      row_range(st, r0, r1);
-      r0 = std::max(r0, band_r0);
-      r1 = std::min(r1, band_r1);
-      const double x0 = std::min({st.x[0], st.x[1], st.x[2]}), x1 = std::max({st.x[0], st.x[1], st.x[2]});
-      const int c0 = int(std::max(0.0, std::ceil(x0 - 0.5)));
-      const int c1 = int(std::min(double(width - 1), std::floor(x1 - 0.5)));
-      for (int r = r0; r <= r1; ++r) {
+      // Edge function of the edge opposite corner j, scaled by 1/area so that it is the barycentric
+      // coordinate: e_j(x, y) = a_j·x + b_j·y + c_j.
+      double ea[3], eb[3], ec[3];
+      for (int j = 0; j < 3; ++j) {
+        const int a = (j + 1) % 3, c = (j + 2) % 3;
+        ea[j] = -(st.y[c] - st.y[a]) / area;
+        eb[j] = (st.x[c] - st.x[a]) / area;
+        ec[j] = -(ea[j] * st.x[a] + eb[j] * st.y[a]);
+      }
+      for (int r = std::max(st.r0, band_r0); r <= std::min(st.r1, band_r1); ++r) {
         const double py = r + 0.5;
-        for (int col = c0; col <= c1; ++col) {
+        for (int col = st.c0; col <= st.c1; ++col) {
           const double px = col + 0.5;
-          double b[3];
-          for (int j = 0; j < 3; ++j) {
-            const int a = (j + 1) % 3, c = (j + 2) % 3;
-            b[j] = ((st.x[c] - st.x[a]) * (py - st.y[a]) - (px - st.x[a]) * (st.y[c] - st.y[a])) / area;
-          }
-          if (b[0] < 0 || b[1] < 0 || b[2] < 0) continue;
-          const float z = float(1.0 / (b[0] * st.inv_z[0] + b[1] * st.inv_z[1] + b[2] * st.inv_z[2]));
+          const double b0 = ea[0] * px + eb[0] * py + ec[0];
+          const double b1 = ea[1] * px + eb[1] * py + ec[1];
+          const double b2 = ea[2] * px + eb[2] * py + ec[2];
+          if (b0 < 0 || b1 < 0 || b2 < 0) continue;
+          const float z = float(1.0 / (b0 * st.inv_z[0] + b1 * st.inv_z[1] + b2 * st.inv_z[2]));
           float& cur = out.depth(col, r);
           std::uint32_t& cur_face = out.face(col, r);
           if (z < cur || (z == cur && st.face < cur_face)) {

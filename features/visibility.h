@@ -14,7 +14,7 @@ struct VisibilityOptions {
   /// It absorbs the tessellation and pixel-quantisation error of the z-buffer (about 1 % at grazing angles).
   double depth_tolerance = 0.01;
   double step_px = 0.5;              ///< sample spacing along a projected segment, depth-buffer pixels (> 0)
-  double silhouette_radius_px = 2.0; ///< background within this many depth-buffer pixels -> exterior silhouette
+  double silhouette_radius_px = 1.5; ///< background within this many depth-buffer pixels -> exterior silhouette
   /// Which contour kinds to keep: with Silhouette set, contour pieces that border the background become
   /// LineClass::Silhouette; non-silhouette contour pieces are kept only with Contour set. Other classes
   /// pass through (visible parts only).

@@ -231,10 +231,17 @@ double compute_feature_size(const MeshCurvature& c, const TriMesh& mesh) {
   return *which > 0 ? std::min(0.01 / *which, max_size) : max_size;
 }
 
-}  // namespace
+/// Six times the volume enclosed by the triangles, measured from `origin` (serial: deterministic).
+double signed_volume6(const TriMesh& mesh, const Vec3d& origin) {
+  double sum = 0;
+  for (std::size_t f = 0; f < mesh.triangle_count(); ++f) {
+    const auto p = face_points(mesh, f);
+    sum += dot(p[0] - origin, cross(p[1] - origin, p[2] - origin));
+  }
+  return sum;
+}
 
-MeshCurvature compute_curvature(const TriMesh& mesh, const CurvatureOptions& options) {
-  validate(mesh);
+MeshCurvature compute_oriented(const TriMesh& mesh, const CurvatureOptions& options) {
   const std::size_t nv = mesh.vertex_count(), nf = mesh.triangle_count();
   const bool threaded = options.threaded;
   MeshCurvature out;
@@ -446,6 +453,24 @@ MeshCurvature compute_curvature(const TriMesh& mesh, const CurvatureOptions& opt
   }
   out.feature_size = compute_feature_size(out, mesh);
   return out;
+}
+
+}  // namespace
+
+MeshCurvature compute_curvature(const TriMesh& mesh, const CurvatureOptions& options) {
+  validate(mesh);
+  if (options.orient_outward) {
+    Bbox3d box;
+    for (const Vec3f& p : mesh.positions) box.expand(Vec3d(p));
+    if (signed_volume6(mesh, box.center()) < 0) {
+      TriMesh reversed = mesh;
+      for (auto& t : reversed.triangles) std::swap(t[1], t[2]);
+      MeshCurvature c = compute_oriented(reversed, options);
+      c.is_flipped = true;
+      return c;
+    }
+  }
+  return compute_oriented(mesh, options);
 }
 
 }  // namespace raysift::mesh

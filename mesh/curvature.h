@@ -28,6 +28,9 @@ struct MeshCurvature {
   /// rtsc feature size fs = min(0.01 / P10(|k|), 0.05 · bounding radius), world length; scales line thresholds.
   double feature_size = 0.0;
 
+  /// True when the triangles were wound inward (negative signed volume) and were reversed internally so
+  /// that normals point outward (CurvatureOptions::orient_outward).
+  bool is_flipped = false;
   std::size_t degenerate_faces = 0;       ///< zero-area faces, skipped
   std::size_t boundary_vertices = 0;      ///< on an open boundary (one-sided fits, kept)
   std::size_t nonmanifold_vertices = 0;   ///< more than one face fan or an edge with > 2 faces (skipped)
@@ -36,6 +39,10 @@ struct MeshCurvature {
 
 struct CurvatureOptions {
   bool threaded = true;  ///< false = serial path (same result)
+  /// Real scans are often wound inward (the Stanford bunny is). When the signed volume about the bbox
+  /// centre is negative, compute as if every triangle were reversed, so normals point out of the object
+  /// and a convex region has positive curvature. Meshes with holes get the sign of their closed part.
+  bool orient_outward = true;
 };
 
 /// Computes normals, point areas, principal curvatures/directions and the derivative tensor.

@@ -127,6 +127,22 @@ TEST(Curvature, DegenerateFacesAreSkippedAndCounted) {
   EXPECT_NEAR(c.k1[0], 1.0, 0.05);  // the sliver does not disturb its neighbours
 }
 
+TEST(Curvature, InwardWoundMeshIsReorientedOutward) {
+  TriMesh inward = make_icosphere(2.0, 3);
+  for (auto& t : inward.triangles) std::swap(t[1], t[2]);
+  const MeshCurvature c = compute_curvature(inward);
+  EXPECT_TRUE(c.is_flipped);
+  for (std::size_t v = 0; v < inward.vertex_count(); v += 37) {
+    EXPECT_NEAR(c.k1[v], 0.5, 0.02);
+    EXPECT_GT(dot(Vec3d(c.normals[v]), Vec3d(inward.positions[v])), 0.0);  // outward
+  }
+  CurvatureOptions keep;
+  keep.orient_outward = false;
+  const MeshCurvature raw = compute_curvature(inward, keep);
+  EXPECT_FALSE(raw.is_flipped);
+  EXPECT_NEAR(raw.k1[0], -0.5, 0.02);  // inward normals: a sphere curves the other way
+}
+
 TEST(Curvature, RejectsEmptyNanAndOutOfRangeMeshes) {
   EXPECT_THROW(compute_curvature(TriMesh{}), InvalidInput);
   TriMesh nan_mesh = make_icosphere(1.0, 1);
