@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 #include <numeric>
+#include <sstream>
 
 #include "core/errors.h"
 #include "core/file_util.h"
@@ -92,17 +93,18 @@ void write_lines_svg(const std::string& path, const FeatureLines& lines, const C
         << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << camera.width() << "\" height=\"" << camera.height()
         << "\" viewBox=\"0 0 " << camera.width() << ' ' << camera.height() << "\">\n";
     for (LineClass c : kDrawOrder) {
-      if (lines.count(c) == 0) continue;
-      out << "<g id=\"" << line_class_name(c) << "\" stroke=\"" << hex_colour(line_class_colour(c))
-          << "\" stroke-width=\"" << line_width_px << "\" stroke-linecap=\"round\">\n";
+      std::ostringstream group;
       for (const LineSegment& s : lines.segments) {
         if (s.line_class != c) continue;
         const auto a = camera.project(Vec3d(s.p0_ws)), b = camera.project(Vec3d(s.p1_ws));
         if (!a || !b) continue;
-        out << "<line x1=\"" << a->x_ss << "\" y1=\"" << a->y_ss << "\" x2=\"" << b->x_ss << "\" y2=\"" << b->y_ss
-            << "\"/>\n";
+        group << "<line x1=\"" << a->x_ss << "\" y1=\"" << a->y_ss << "\" x2=\"" << b->x_ss << "\" y2=\"" << b->y_ss
+              << "\"/>\n";
       }
-      out << "</g>\n";
+      if (group.tellp() == 0) continue;
+      out << "<g id=\"" << line_class_name(c) << "\" stroke=\"" << hex_colour(line_class_colour(c))
+          << "\" stroke-width=\"" << line_width_px << "\" stroke-linecap=\"round\">\n"
+          << group.str() << "</g>\n";
     }
     out << "</svg>\n";
     out.flush();
