@@ -2,7 +2,8 @@
 // plus reducing its depth and warping the map to the next camera of a 60-frame orbit) against the
 // full-quality ray-cast of the same 1440x900 view, measured in the same run. Target: <= 5 %.
 //
-// Usage: saliency_bench [VOLUME.vdb [TF.json]]   (default: datasets/engine_ct.vdb, a bone-like ramp TF)
+// Usage: saliency_bench [VOLUME.vdb [TF.json [CAMERA.json]]]  (default: datasets/engine_ct{.vdb,_tf.json,_camera.json};
+// the camera is rendered at 1440x900)
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -12,7 +13,7 @@
 #include <vector>
 
 #include "core/camera.h"
-#include "core/file_util.h"
+#include "core/json_io.h"
 #include "core/timer.h"
 #include "features/saliency.h"
 #include "features/warp.h"
@@ -36,42 +37,33 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-/// Camera on an orbit around the volume's centre at `angle_deg`, 20 degrees above the equator.
-CameraSpec orbit_camera(const volume::GridInfo& info, double angle_deg) {
-  const Vec3d centre = (info.bbox_min + info.bbox_max) * 0.5;
-  const double radius = 1.6 * length(info.bbox_max - info.bbox_min);
-  const double a = angle_deg * M_PI / 180.0, e = 20.0 * M_PI / 180.0;
-  CameraSpec s;
-  s.target = centre;
-  s.eye = centre + Vec3d{std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a)} * radius;
-  s.up = {0, 1, 0};
-  s.fov_y_deg = 35;
-  s.width = 1440;
-  s.height = 900;
-  return s;
-}
-
-/// Transparent below 30 % of the value range, then a ramp to a fairly opaque bone white.
-volume::TransferFunction default_tf(const volume::GridInfo& info) {
-  const double lo = info.value_min, span = std::max(info.value_max - info.value_min, 1e-6);
-  return volume::TransferFunction({{lo, 0, 0, 0, 0},
-                                   {lo + 0.30 * span, 0.8f, 0.3f, 0.2f, 0.0f},
-                                   {lo + 0.55 * span, 0.9f, 0.7f, 0.5f, 0.15f},
-                                   {lo + span, 1.0f, 1.0f, 0.95f, 0.6f}});
+/// `spec` moved along its orbit around the target by `angle_deg` about the up axis (one step of a
+/// 60-frame orbit is 6 degrees).
+CameraSpec orbit_step(CameraSpec spec, double angle_deg) {
+  const Vec3d axis = normalize(spec.up), offset = spec.eye - spec.target;
+  const double a = angle_deg * M_PI / 180.0;
+  // Rodrigues' rotation of the eye offset about the up axis.
+  spec.eye = spec.target + offset * std::cos(a) + cross(axis, offset) * std::sin(a) +
+             axis * (dot(axis, offset) * (1.0 - std::cos(a)));
+  return spec;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::string vdb_path = argc > 1 ? argv[1] : std::string(RAYSIFT_SOURCE_DIR) + "/datasets/engine_ct.vdb";
+  const std::string data = std::string(RAYSIFT_SOURCE_DIR) + "/datasets/";
+  const std::string vdb_path = argc > 1 ? argv[1] : data + "engine_ct.vdb";
+  const std::string tf_path = argc > 2 ? argv[2] : data + "engine_ct_tf.json";
+  const std::string camera_path = argc > 3 ? argv[3] : data + "engine_ct_camera.json";
   try {
     const volume::Volume vol = volume::load_vdb(vdb_path);
-    const volume::GridInfo info = vol.info();
-    const volume::TransferFunction tf = argc > 2 ? volume::load_transfer_function(argv[2]) : default_tf(info);
-    const CameraSpec prev_spec = orbit_camera(info, 0.0), cur_spec = orbit_camera(info, 6.0);  // 360/60 deg
-    volume::RenderOptions ro;
-    ro.shading = volume::Shading::Phong;
-    const volume::RayCaster caster(vol, tf, prev_spec, ro);
+    const volume::TransferFunction tf = volume::load_transfer_function(tf_path);
+    CameraSpec prev_spec = camera_spec_from_json(read_json_file(camera_path), camera_path);
+    prev_spec.width = 1440;
+    prev_spec.height = 900;
+    const CameraSpec cur_spec = orbit_step(prev_spec, 6.0);
+    // The defaults of `raysift render --mode full` (no shading, 0.5-voxel steps, early termination).
+    const volume::RayCaster caster(vol, tf, prev_spec);
 
     // Rounds interleave the reference and the measured stages so that a change in machine load
     // during the run affects both sides of the ratio alike.
@@ -95,7 +87,7 @@ int main(int argc, char** argv) {
     const double render_ms = median(render_runs), saliency_ms = median(saliency_runs), warp_ms = median(warp_runs);
 
     const double total = saliency_ms + warp_ms;
-    std::printf("saliency_bench: %s, %dx%d, %d threads, Phong, step 0.5 voxel\n", vdb_path.c_str(),
+    std::printf("saliency_bench: %s + %s, %dx%d, %d threads, render defaults\n", vdb_path.c_str(), tf_path.c_str(),
                 prev_spec.width, prev_spec.height, tbb::this_task_arena::max_concurrency());
     std::printf("%-34s %10s\n", "stage", "ms");
     std::printf("%-34s %10.2f   (median of %d, %llu rays)\n", "full render (reference)", render_ms, rounds,
