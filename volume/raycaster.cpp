@@ -1,12 +1,12 @@
 // Emission-absorption ray caster. Rays live in index space (t in voxels) so that the step, the opacity
 // correction and the 8³ skip blocks all use voxel units; depth is converted back to world distance.
-// Empty-space skipping tests the block of every would-be sample position and jumps over whole steps,
-// so skipped samples are exactly those whose TF lookup would give zero opacity: the image is
-// identical to the brute-force path.
+// Samples read 9³ bricks (detail/brick_cache.h) instead of walking the OpenVDB tree: no per-thread
+// accessors, no branches on leaf borders. Empty-space skipping tests the block of every would-be
+// sample position and jumps over whole steps, so skipped samples are exactly those whose TF lookup
+// would give zero opacity: the image is identical to the brute-force path.
 #include "volume/raycaster.h"
 
 #include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -15,60 +15,14 @@
 #include <sstream>
 
 #include "core/errors.h"
-#include "volume/detail/block_ranges.h"
+#include "volume/detail/brick_cache.h"
 #include "volume/detail/vdb_grid.h"
 
 namespace raysift::volume {
 
 namespace {
 
-using Tree = openvdb::FloatTree;
-using Leaf = Tree::LeafNodeType;
-using detail::kBlockLog2;
-using detail::kBlockSize;
-
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-/// Trilinear reconstruction with a one-leaf cache: when the 2×2×2 support lies inside one leaf (7/8
-/// per axis) the values are read straight from the leaf buffer; otherwise through the accessor.
-/// Voxel (i,j,k)'s value sits at index point (i,j,k) (OpenVDB convention). Not thread-safe: one per thread.
-class TrilinearSampler {
- public:
-  explicit TrilinearSampler(const Tree& tree) : acc_(tree) {}
-
-  float sample(double x, double y, double z) {
-    const double fx = std::floor(x), fy = std::floor(y), fz = std::floor(z);
-    const int ix = int(fx), iy = int(fy), iz = int(fz);
-    const float tx = float(x - fx), ty = float(y - fy), tz = float(z - fz);
-    float v[8];  // v[dx*4 + dy*2 + dz]
-    if ((ix & 7) != 7 && (iy & 7) != 7 && (iz & 7) != 7) {
-      const openvdb::Coord origin(ix & ~7, iy & ~7, iz & ~7);
-      if (!has_cached_ || origin != cached_origin_) {
-        cached_leaf_ = acc_.probeConstLeaf(origin);
-        if (!cached_leaf_) cached_constant_ = acc_.getValue(origin);
-        cached_origin_ = origin;
-        has_cached_ = true;
-      }
-      if (!cached_leaf_) return cached_constant_;
-      const float* d = cached_leaf_->buffer().data() + (((ix & 7) << 6) | ((iy & 7) << 3) | (iz & 7));
-      v[0] = d[0], v[1] = d[1], v[2] = d[8], v[3] = d[9];
-      v[4] = d[64], v[5] = d[65], v[6] = d[72], v[7] = d[73];
-    } else {
-      for (int c = 0; c < 8; ++c) v[c] = acc_.getValue(openvdb::Coord(ix + (c >> 2), iy + (c >> 1 & 1), iz + (c & 1)));
-    }
-    const float a = v[0] + (v[1] - v[0]) * tz, b = v[2] + (v[3] - v[2]) * tz;
-    const float c = v[4] + (v[5] - v[4]) * tz, d = v[6] + (v[7] - v[6]) * tz;
-    const float e = a + (b - a) * ty, f = c + (d - c) * ty;
-    return e + (f - e) * tx;
-  }
-
- private:
-  openvdb::tree::ValueAccessor<const Tree, false> acc_;
-  const Leaf* cached_leaf_ = nullptr;
-  float cached_constant_ = 0.0f;
-  openvdb::Coord cached_origin_;
-  bool has_cached_ = false;
-};
 
 /// splitmix64 finaliser: a well-mixed 64-bit hash for per-pixel jitter.
 std::uint64_t hash64(std::uint64_t v) {
@@ -117,7 +71,7 @@ void validate(const RenderOptions& o) {
 }  // namespace
 
 struct RayCaster::Impl {
-  const Tree* tree = nullptr;
+  std::shared_ptr<const VolumeBricks> bricks;
   Camera camera;
   RenderOptions options;
   double world_to_index[3][3] = {};  ///< linear part of the grid's world -> index map
@@ -130,17 +84,13 @@ struct RayCaster::Impl {
 
   bool is_empty = true;
   Vec3d domain_lo, domain_hi;  ///< active bbox dilated by one voxel, index space
-  Vec3i block_min, block_dims;
-  std::vector<std::uint8_t> block_visible;
+  std::vector<std::uint8_t> block_visible;  ///< per brick-table block
   bool has_visible = false;
   Vec3d visible_lo, visible_hi;  ///< bbox of visible blocks' cells, index space
   std::uint64_t visible_blocks = 0;
 
-  mutable tbb::enumerable_thread_specific<TrilinearSampler> samplers;
-
-  Impl(const Volume& volume, const CameraSpec& spec, const RenderOptions& opt)
-      : tree(&volume.impl().grid->tree()), camera(spec), options(opt),
-        samplers([t = &volume.impl().grid->tree()] { return TrilinearSampler(*t); }) {}
+  Impl(std::shared_ptr<const VolumeBricks> b, const CameraSpec& spec, const RenderOptions& opt)
+      : bricks(std::move(b)), camera(spec), options(opt) {}
 
   Vec3d to_index_dir(const Vec3d& d) const {
     return {world_to_index[0][0] * d.x + world_to_index[0][1] * d.y + world_to_index[0][2] * d.z,
@@ -175,11 +125,8 @@ struct RayCaster::Impl {
   }
 
   bool block_is_visible(int bx, int by, int bz) const {
-    bx -= block_min.x;
-    by -= block_min.y;
-    bz -= block_min.z;
-    if (bx < 0 || by < 0 || bz < 0 || bx >= block_dims.x || by >= block_dims.y || bz >= block_dims.z) return false;
-    return block_visible[(std::size_t(bz) * block_dims.y + by) * block_dims.x + bx] != 0;
+    const std::int64_t b = bricks->block_index(bx, by, bz);
+    return b >= 0 && block_visible[std::size_t(b)] != 0;
   }
 
   /// Ray parameter where the ray leaves block (bx,by,bz).
@@ -194,16 +141,18 @@ struct RayCaster::Impl {
     return t;
   }
 
-  Vec3d gradient_is(TrilinearSampler& s, const Vec3d& p) const {
-    return {0.5 * (double(s.sample(p.x + 1, p.y, p.z)) - s.sample(p.x - 1, p.y, p.z)),
-            0.5 * (double(s.sample(p.x, p.y + 1, p.z)) - s.sample(p.x, p.y - 1, p.z)),
-            0.5 * (double(s.sample(p.x, p.y, p.z + 1)) - s.sample(p.x, p.y, p.z - 1))};
+  float sample(double x, double y, double z) const { return bricks->sample(Cell(x, y, z)); }
+
+  Vec3d gradient_is(const Vec3d& p) const {
+    return {0.5 * (double(sample(p.x + 1, p.y, p.z)) - sample(p.x - 1, p.y, p.z)),
+            0.5 * (double(sample(p.x, p.y + 1, p.z)) - sample(p.x, p.y - 1, p.z)),
+            0.5 * (double(sample(p.x, p.y, p.z + 1)) - sample(p.x, p.y, p.z - 1))};
   }
 
   /// Blinn-Phong on a premultiplied sample (two-sided); returns the shaded premultiplied colour.
-  Rgba shade(TrilinearSampler& s, const Vec3d& p_is, const Vec3d& dir_ws, const Rgba& c) const {
+  Rgba shade(const Vec3d& p_is, const Vec3d& dir_ws, const Rgba& c) const {
     const PhongParams& ph = options.phong;
-    const Vec3d g_is = gradient_is(s, p_is);
+    const Vec3d g_is = gradient_is(p_is);
     const double g_len = length(g_is);
     if (!(g_len >= ph.min_gradient) || !std::isfinite(g_len)) {
       const float k = ph.ambient + ph.diffuse;  // flat region: lit as if facing the light, no highlight
@@ -257,7 +206,6 @@ RaySample RayCaster::Impl::trace(int x, int y) const {
     t_end = std::min(t_out, tv_out + dt);
   }
 
-  TrilinearSampler& sampler = samplers.local();
   const bool shaded = options.shading == Shading::Phong;
   const float termination = float(options.early_termination);
   const bool terminates = options.early_termination < 1.0;
@@ -267,9 +215,9 @@ RaySample RayCaster::Impl::trace(int x, int y) const {
     const double t = t_in + (double(k) + xi) * dt;
     if (!(t < t_end)) break;
     const Vec3d p = o + dir * t;
+    const Cell cell(p.x, p.y, p.z);
     if (skip) {
-      const int bx = int(std::floor(p.x)) >> kBlockLog2, by = int(std::floor(p.y)) >> kBlockLog2,
-                bz = int(std::floor(p.z)) >> kBlockLog2;
+      const int bx = cell.ix >> kBlockLog2, by = cell.iy >> kBlockLog2, bz = cell.iz >> kBlockLog2;
       if (!block_is_visible(bx, by, bz)) {
         // Jump to one step before the block exit; the next position is tested again.
         const double t_exit = block_exit(o, inv_d, bx, by, bz);
@@ -280,9 +228,9 @@ RaySample RayCaster::Impl::trace(int x, int y) const {
     }
     ++k;
     ++samples;
-    Rgba c = lookup(sampler.sample(p.x, p.y, p.z));
+    Rgba c = lookup(bricks->sample(cell));
     if (c.a == 0.0f) continue;  // contributes exactly nothing
-    if (shaded) c = shade(sampler, p, ray.direction, c);
+    if (shaded) c = shade(p, ray.direction, c);
     const float w = 1.0f - ca;
     cr += w * c.r;
     cg += w * c.g;
@@ -296,21 +244,30 @@ RaySample RayCaster::Impl::trace(int x, int y) const {
   return out;
 }
 
+std::shared_ptr<const VolumeBricks> build_volume_bricks(const Volume& volume) {
+  return std::make_shared<const VolumeBricks>(build_volume_bricks_from_grid(*volume.impl().grid));
+}
+
 RayCaster::RayCaster(const Volume& volume, const TransferFunction& tf, const CameraSpec& camera,
-                     const RenderOptions& options) {
+                     const RenderOptions& options)
+    : RayCaster(volume, nullptr, tf, camera, options) {}
+
+RayCaster::RayCaster(const Volume& volume, std::shared_ptr<const VolumeBricks> bricks, const TransferFunction& tf,
+                     const CameraSpec& camera, const RenderOptions& options) {
   validate(options);
-  impl_ = std::make_unique<Impl>(volume, camera, options);
-  Impl& m = *impl_;
   const openvdb::FloatGrid& grid = *volume.impl().grid;
   const openvdb::math::Transform& xform = grid.transform();
   if (!xform.isLinear())
     throw InvalidInput("volume '" + grid.getName() + "': the ray caster needs a linear index-to-world transform");
-  const openvdb::Vec3d eye = xform.worldToIndex(openvdb::Vec3d(camera.eye.x, camera.eye.y, camera.eye.z));
+  impl_ = std::make_unique<Impl>(bricks ? std::move(bricks) : build_volume_bricks(volume), camera, options);
+  Impl& m = *impl_;
+  const openvdb::Vec3d eye_ws(camera.eye.x, camera.eye.y, camera.eye.z);
+  const openvdb::Vec3d eye = xform.worldToIndex(eye_ws);
   m.eye_is = {eye.x(), eye.y(), eye.z()};
   for (int a = 0; a < 3; ++a) {
     openvdb::Vec3d unit(0, 0, 0);
     unit[a] = 1;
-    const openvdb::Vec3d col = xform.worldToIndex(openvdb::Vec3d(camera.eye.x, camera.eye.y, camera.eye.z) + unit) - eye;
+    const openvdb::Vec3d col = xform.worldToIndex(eye_ws + unit) - eye;
     for (int r = 0; r < 3; ++r) m.world_to_index[r][a] = col[r];
   }
 
@@ -327,20 +284,18 @@ RayCaster::RayCaster(const Volume& volume, const TransferFunction& tf, const Cam
     m.nonzero_prefix[i + 1] = m.nonzero_prefix[i] + (a > 0 ? 1 : 0);
   }
 
-  const detail::BlockRanges ranges = detail::compute_block_ranges(grid);
-  m.is_empty = ranges.is_empty();
+  const VolumeBricks& vb = *m.bricks;
+  m.is_empty = vb.is_empty;
   if (m.is_empty) return;
-  m.domain_lo = Vec3d(ranges.index_min) - Vec3d{1, 1, 1};
-  m.domain_hi = Vec3d(ranges.index_max) + Vec3d{1, 1, 1};
-  m.block_min = ranges.block_min;
-  m.block_dims = ranges.dims;
-  m.block_visible.resize(ranges.lo.size());
+  m.domain_lo = Vec3d(vb.index_min) - Vec3d{1, 1, 1};
+  m.domain_hi = Vec3d(vb.index_max) + Vec3d{1, 1, 1};
+  m.block_visible.resize(vb.lo.size());
   Vec3i vis_lo{INT32_MAX, INT32_MAX, INT32_MAX}, vis_hi{INT32_MIN, INT32_MIN, INT32_MIN};
-  for (int k = 0; k < m.block_dims.z; ++k)
-    for (int j = 0; j < m.block_dims.y; ++j)
-      for (int i = 0; i < m.block_dims.x; ++i) {
-        const std::size_t idx = (std::size_t(k) * m.block_dims.y + j) * m.block_dims.x + i;
-        const bool visible = m.range_visible(ranges.lo[idx], ranges.hi[idx]);
+  for (int k = 0; k < vb.dims.z; ++k)
+    for (int j = 0; j < vb.dims.y; ++j)
+      for (int i = 0; i < vb.dims.x; ++i) {
+        const std::size_t idx = (std::size_t(k) * vb.dims.y + j) * vb.dims.x + i;
+        const bool visible = m.range_visible(vb.lo[idx], vb.hi[idx]);
         m.block_visible[idx] = visible ? 1 : 0;
         if (!visible) continue;
         ++m.visible_blocks;
@@ -349,8 +304,8 @@ RayCaster::RayCaster(const Volume& volume, const TransferFunction& tf, const Cam
       }
   m.has_visible = m.visible_blocks > 0;
   if (m.has_visible) {
-    const Vec3d lo_cells = Vec3d(vis_lo + m.block_min) * double(kBlockSize);
-    const Vec3d hi_cells = Vec3d(vis_hi + m.block_min + Vec3i{1, 1, 1}) * double(kBlockSize);
+    const Vec3d lo_cells = Vec3d(vis_lo + vb.block_min) * double(kBlockSize);
+    const Vec3d hi_cells = Vec3d(vis_hi + vb.block_min + Vec3i{1, 1, 1}) * double(kBlockSize);
     m.visible_lo = max(lo_cells, m.domain_lo);
     m.visible_hi = min(hi_cells, m.domain_hi);
   }
@@ -386,6 +341,31 @@ bool RayCaster::pixel_is_background(int x, int y) const {
   const Vec3d inv_d{1.0 / d.x, 1.0 / d.y, 1.0 / d.z};
   double t0, t1;
   return !clip_to_box(m.eye_is, inv_d, m.visible_lo, m.visible_hi, t0, t1) || t1 < 0.0;
+}
+
+CameraSpec fit_camera(const Volume& volume, int width, int height) {
+  CameraSpec c;
+  c.width = width;
+  c.height = height;
+  c.fov_y_deg = 30.0;
+  static_cast<void>(Camera{c});  // validates the image size
+  const GridInfo info = volume.info();
+  Bbox3d box;
+  if (info.active_voxels > 0) {
+    box.expand(info.bbox_min);
+    box.expand(info.bbox_max);
+  } else {
+    box.expand({-0.5, -0.5, -0.5});
+    box.expand({0.5, 0.5, 0.5});
+  }
+  const double radius = std::max(0.5 * box.diagonal(), 1e-6);
+  const double half_y = 0.5 * c.fov_y_deg * M_PI / 180.0;
+  const double half_x = std::atan(std::tan(half_y) * double(width) / double(height));
+  const double distance = radius / std::sin(std::min(half_x, half_y));
+  c.target = box.center();
+  c.eye = c.target + Vec3d{0, 0, distance};
+  c.up = {0, 1, 0};
+  return c;
 }
 
 RenderResult render_full(const RayCaster& caster, const ProgressCallback& progress, bool threaded) {

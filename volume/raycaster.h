@@ -14,7 +14,7 @@
 /// Optics (ALGORITHMS.md §8): front-to-back compositing of samples at t_k = t_entry + (k + ξ)·Δt
 /// along the index-space ray, trilinear reconstruction, TF opacity defined per voxel length and
 /// corrected to α_s = 1 − (1 − α)^s for a step of s voxels. Empty-space skipping works on 8³ blocks
-/// (the OpenVDB leaf size) whose value range maps to exactly zero opacity; it skips whole steps, so the
+/// (the OpenVDB leaf size) whose sample value range maps to exactly zero opacity; it skips whole steps, so the
 /// sample lattice and hence the image are identical with and without it.
 #include <cstdint>
 #include <functional>
@@ -68,8 +68,16 @@ inline Rgba composite_over_background(const Rgba& premultiplied, const Vec3f& ba
           premultiplied.b + t * background.z, premultiplied.a};
 }
 
-/// \warning Thread-safe for concurrent trace calls (per-thread OpenVDB accessors inside); the Volume
-/// must outlive the RayCaster. Not copyable; building it costs one pass over the tree's leaves.
+/// TF- and camera-independent acceleration data of a volume: 9³ bricks (each 8³ leaf block plus a
+/// one-voxel apron) and per-block value ranges. Defined in volume/detail/brick_cache.h.
+struct VolumeBricks;
+
+/// Builds the bricks once so that several RayCasters (new TF, new camera) can share them.
+/// Memory: 2.9 KB per 8³ block whose trilinear support is not constant.
+std::shared_ptr<const VolumeBricks> build_volume_bricks(const Volume& volume);
+
+/// \warning Thread-safe for concurrent trace calls (no per-thread state: samples read the immutable
+/// bricks). Not copyable. Construction costs one pass over the tree's leaves unless bricks are passed in.
 class RayCaster {
  public:
   /// \throw InvalidInput for a step outside (0, 64], early termination outside (0, 1], lut_size < 2,
@@ -77,6 +85,10 @@ class RayCaster {
   ///        (see Camera).
   RayCaster(const Volume& volume, const TransferFunction& tf, const CameraSpec& camera,
             const RenderOptions& options = {});
+  /// Same, reusing bricks from build_volume_bricks(volume) (recomputes only the TF-dependent
+  /// visibility of each block). \pre `bricks` was built from `volume`.
+  RayCaster(const Volume& volume, std::shared_ptr<const VolumeBricks> bricks, const TransferFunction& tf,
+            const CameraSpec& camera, const RenderOptions& options = {});
   ~RayCaster();
   RayCaster(const RayCaster&) = delete;
   RayCaster& operator=(const RayCaster&) = delete;
@@ -108,6 +120,12 @@ struct RenderResult {
   std::uint64_t rays_traced = 0;
   std::uint64_t samples = 0;
 };
+
+/// Default view of a volume: ParaView's default direction (eye on the +z side of the world bbox centre,
+/// up = +y), vertical field of view 30°, at the distance where the bbox's bounding sphere just fits the
+/// narrower image axis. An empty volume gets the view of a unit box at the origin.
+/// \throw InvalidInput for an image side outside 1..kMaxImageSide.
+CameraSpec fit_camera(const Volume& volume, int width, int height);
 
 /// Called with the finished fraction in [0,1], from worker threads (must be thread-safe).
 using ProgressCallback = std::function<void(double fraction)>;

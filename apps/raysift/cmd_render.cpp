@@ -1,0 +1,242 @@
+// raysift render: volume ray casting. The flow is parse -> build (volume, TF, camera, caster) -> run
+// the selected mode -> write. A new mode adds one entry to `modes()` (and its flags in the setup
+// lambda); everything before and after the dispatch is shared, so all modes composite and write alike.
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include "apps/raysift/command.h"
+#include "core/file_util.h"
+#include "core/image.h"
+#include "core/progress.h"
+#include "core/scene.h"
+#include "core/timer.h"
+#include "volume/raycaster.h"
+#include "volume/transfer_function.h"
+#include "volume/vdb_io.h"
+
+namespace raysift::app {
+namespace {
+
+struct RenderCliOptions {
+  std::string volume, grid, tf, camera, out;
+  std::string mode = "full";
+  int width = -1, height = -1;  ///< -1 = from the camera file / scene / 512
+  double step = volume::RenderOptions{}.step_voxels;
+  std::string shading = "none";
+  std::string background = "0,0,0";
+  double early_termination = volume::RenderOptions{}.early_termination;
+  bool no_skip = false, jitter = false, tf_normalized = false;
+  std::string pixel;  ///< "x,y": trace one pixel serially and print it
+};
+
+/// Everything a mode needs, built once from flags and scene.
+struct RenderInputs {
+  volume::Volume volume;
+  std::unique_ptr<volume::TransferFunction> tf;
+  CameraSpec camera;
+  volume::RenderOptions options;
+};
+
+/// What a mode returns: the final image (composited, alpha = accumulated opacity) and its counts.
+struct ModeOutput {
+  ImageRGBA image;
+  std::uint64_t rays_traced = 0;
+  std::uint64_t samples = 0;
+  Json extra_stats = Json::object();  ///< mode-specific keys merged into the stats file
+};
+
+using ModeFunction = std::function<ModeOutput(const RenderInputs&, const volume::RayCaster&, const CommonOptions&)>;
+
+const std::map<std::string, ModeFunction>& modes() {
+  static const std::map<std::string, ModeFunction> table = {
+      {"full",
+       [](const RenderInputs&, const volume::RayCaster& caster, const CommonOptions& common) {
+         ProgressBar bar("render", !common.quiet);
+         volume::RenderResult r = volume::render_full(caster, [&bar](double f) { bar.update(f); });
+         return ModeOutput{std::move(r.image), r.rays_traced, r.samples, Json::object()};
+       }},
+  };
+  return table;
+}
+
+std::string mode_names() {
+  std::string names;
+  for (const auto& [name, fn] : modes()) names += (names.empty() ? "" : "|") + name;
+  return names;
+}
+
+Vec3f parse_background(const std::string& text) {
+  std::stringstream s(text);
+  std::string item;
+  std::vector<float> v;
+  while (std::getline(s, item, ',')) {
+    try {
+      std::size_t used = 0;
+      v.push_back(std::stof(item, &used));
+      if (used != item.size()) v.push_back(NAN);
+    } catch (const std::exception&) {
+      v.push_back(NAN);
+    }
+  }
+  if (v.size() != 3 || !std::all_of(v.begin(), v.end(), [](float c) { return c >= 0.0f && c <= 1.0f; }))
+    bad_flag("--background", "three comma-separated linear values in [0,1] (R,G,B)", text);
+  return {v[0], v[1], v[2]};
+}
+
+void validate(const RenderCliOptions& o) {
+  if (!modes().count(o.mode)) bad_flag("--mode", mode_names(), o.mode);
+  if (!(o.step > 0 && o.step <= 64)) bad_flag("--step", "in (0, 64] voxels", std::to_string(o.step));
+  if (!(o.early_termination > 0 && o.early_termination <= 1))
+    bad_flag("--early-termination", "in (0, 1]", std::to_string(o.early_termination));
+  if (o.width != -1 && (o.width < 1 || o.width > kMaxImageSide))
+    bad_flag("--width", "1.." + std::to_string(kMaxImageSide), std::to_string(o.width));
+  if (o.height != -1 && (o.height < 1 || o.height > kMaxImageSide))
+    bad_flag("--height", "1.." + std::to_string(kMaxImageSide), std::to_string(o.height));
+  if (o.shading != "none" && o.shading != "phong") bad_flag("--shading", "none|phong", o.shading);
+  const std::string ext = file_extension(o.out);
+  if (ext != ".exr" && ext != ".png") bad_flag("-o/--out", "a .exr or .png path", o.out);
+}
+
+RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common) {
+  Scene scene;
+  if (!common.scene_path.empty()) scene = load_scene(common.scene_path);
+  const std::string volume_path = !o.volume.empty() ? o.volume : scene.volume;
+  if (volume_path.empty()) throw UsageError("render needs a VOLUME argument or a --scene with a 'volume'; see --help");
+  RenderInputs in;
+  in.volume = volume::load_vdb(volume_path, !o.grid.empty() ? o.grid : scene.grid);
+  const volume::GridInfo info = in.volume.info();
+
+  volume::TfJsonOptions tf_options;
+  tf_options.normalized = o.tf_normalized;
+  tf_options.data_min = info.value_min;
+  tf_options.data_max = info.value_max;
+  if (!o.tf.empty())
+    in.tf = std::make_unique<volume::TransferFunction>(volume::load_transfer_function(o.tf, tf_options));
+  else if (!scene.transfer_function.is_null())
+    in.tf = std::make_unique<volume::TransferFunction>(
+        volume::transfer_function_from_json(scene.transfer_function, scene.transfer_function_source, tf_options));
+  else
+    throw UsageError("render needs --tf TF.json or a --scene with a 'transfer_function'; see --help");
+  if (info.value_max < in.tf->domain_min() || info.value_min > in.tf->domain_max()) {
+    if (!common.quiet)
+      std::cerr << "raysift: warning: the transfer function's range [" << in.tf->domain_min() << ", "
+                << in.tf->domain_max() << "] does not overlap the data range [" << info.value_min << ", "
+                << info.value_max << "]; values are clamped to the end points\n";
+  }
+
+  std::optional<CameraSpec> camera = scene.camera;
+  if (!o.camera.empty()) camera = camera_spec_from_json(read_json_file(o.camera), o.camera);
+  const int width = o.width != -1 ? o.width : camera ? camera->width : CameraSpec{}.width;
+  const int height = o.height != -1 ? o.height : camera ? camera->height : CameraSpec{}.height;
+  if (camera) {
+    in.camera = *camera;
+    in.camera.width = width;
+    in.camera.height = height;
+  } else {
+    in.camera = volume::fit_camera(in.volume, width, height);
+  }
+
+  in.options.step_voxels = o.step;
+  in.options.shading = o.shading == "phong" ? volume::Shading::Phong : volume::Shading::None;
+  in.options.background = parse_background(o.background);
+  in.options.early_termination = o.early_termination;
+  in.options.skip_empty_space = !o.no_skip;
+  in.options.jitter = o.jitter;
+  in.options.seed = common.seed;
+  return in;
+}
+
+/// The effective options as a command line that reproduces the render (verbose mode).
+std::string echo_command(const RenderCliOptions& o, const RenderInputs& in, const CommonOptions& common) {
+  std::ostringstream s;
+  s << "raysift render " << (o.volume.empty() ? "--scene " + common.scene_path : o.volume);
+  if (!o.tf.empty()) s << " --tf " << o.tf;
+  if (!o.camera.empty()) s << " --camera " << o.camera;
+  s << " --width " << in.camera.width << " --height " << in.camera.height << " --mode " << o.mode << " --step "
+    << o.step << " --shading " << o.shading << " --background " << o.background << " --early-termination "
+    << o.early_termination << (o.no_skip ? " --no-skip" : "") << (o.jitter ? " --jitter" : "") << " --seed "
+    << common.seed << " --threads " << common.threads << " -o " << o.out;
+  return s.str();
+}
+
+void trace_one_pixel(const std::string& text, const volume::RayCaster& caster) {
+  int x = -1, y = -1;
+  char comma = 0;
+  std::istringstream s(text);
+  if (!(s >> x >> comma >> y) || comma != ',' || !s.eof() || x < 0 || y < 0 || x >= caster.width() ||
+      y >= caster.height())
+    bad_flag("--pixel", "x,y inside the " + std::to_string(caster.width()) + "x" + std::to_string(caster.height()) +
+                            " image", text);
+  const volume::RaySample r = caster.trace(x, y);
+  const Rgba c = volume::composite_over_background(r.color, caster.options().background);
+  std::printf("pixel %d,%d: premultiplied %.6g %.6g %.6g %.6g  composited %.6g %.6g %.6g  depth %.6g  samples %u\n",
+              x, y, r.color.r, r.color.g, r.color.b, r.color.a, c.r, c.g, c.b, r.depth, r.samples);
+}
+
+RegisterCommand reg(
+    "render", "volume ray casting (emission-absorption, transfer function, empty-space skipping)",
+    [](CLI::App& sub, CommonOptions& common) -> RunFunction {
+      auto opt = std::make_shared<RenderCliOptions>();
+      sub.add_option("VOLUME", opt->volume, "input .vdb (default: the scene's volume)");
+      sub.add_option("-o,--out", opt->out, "output image: .exr (linear RGB + alpha = opacity) or .png (sRGB, opaque)")->required();
+      sub.add_option("--grid", opt->grid, "grid name (default: the scene's, else the first float grid)");
+      sub.add_option("--tf", opt->tf, "transfer function JSON (ParaView preset or {\"points\": ...})");
+      sub.add_flag("--tf-normalized", opt->tf_normalized, "TF x values are 0..1 over the data range");
+      sub.add_option("--camera", opt->camera, "camera JSON (default: the scene's, else fitted to the volume)");
+      sub.add_option("--width", opt->width, "image width in pixels, 1..16384 (default: camera's, else 512)");
+      sub.add_option("--height", opt->height, "image height in pixels, 1..16384 (default: camera's, else 512)");
+      sub.add_option("--mode", opt->mode, "render mode: " + mode_names())->capture_default_str();
+      sub.add_option("--step", opt->step, "sample distance in voxels, (0, 64]")->capture_default_str();
+      sub.add_option("--shading", opt->shading, "none|phong (Blinn-Phong, headlight)")->capture_default_str();
+      sub.add_option("--background", opt->background, "background R,G,B (linear, 0..1)")->capture_default_str();
+      sub.add_option("--early-termination", opt->early_termination, "stop a ray at this opacity; 1 disables")
+          ->capture_default_str();
+      sub.add_flag("--no-skip", opt->no_skip, "disable empty-space skipping (same image, slower)");
+      sub.add_flag("--jitter", opt->jitter, "random start offset per ray (from --seed)");
+      sub.add_option("--pixel", opt->pixel, "debug: trace only pixel x,y serially and print it (no image written)");
+      sub.footer(
+          "Examples:\n"
+          "  raysift render datasets/engine_ct.vdb --tf datasets/engine_ct_tf.json -o engine.png\n"
+          "  raysift render --scene datasets/engine_ct_scene.json --shading phong --width 1440 --height 900 "
+          "-o engine.exr --stats stats.json");
+      return [opt, &common] {
+        const Timer total;
+        validate(*opt);
+        const RenderInputs in = build_inputs(*opt, common);
+        const volume::RayCaster caster(in.volume, *in.tf, in.camera, in.options);
+        const double setup_ms = total.elapsed_ms();
+        if (common.verbose) std::cerr << echo_command(*opt, in, common) << "\n";
+        if (!opt->pixel.empty()) {
+          trace_one_pixel(opt->pixel, caster);
+          return;
+        }
+        const Timer trace;
+        ModeOutput result = modes().at(opt->mode)(in, caster, common);
+        const double trace_ms = trace.elapsed_ms();
+        if (file_extension(opt->out) == ".png")  // colour is already composited: show it opaque
+          for (Rgba& p : result.image.pixels) p.a = 1.0f;
+        write_image(opt->out, result.image);
+        const double total_ms = total.elapsed_ms();
+        if (common.verbose)
+          std::cerr << "setup " << setup_ms << " ms, trace " << trace_ms << " ms, total " << total_ms << " ms, "
+                    << result.samples << " samples\n";
+        Json stats = {{"mode", opt->mode},
+                      {"width", in.camera.width},
+                      {"height", in.camera.height},
+                      {"rays_traced", result.rays_traced},
+                      {"samples", result.samples},
+                      {"step_voxels", in.options.step_voxels},
+                      {"skip_empty_space", in.options.skip_empty_space},
+                      {"visible_blocks", caster.visible_block_count()},
+                      {"times_ms", {{"setup", setup_ms}, {"trace", trace_ms}, {"total", total_ms}}}};
+        stats.update(result.extra_stats);
+        write_stats_if_requested(common, stats);
+      };
+    });
+
+}  // namespace
+}  // namespace raysift::app

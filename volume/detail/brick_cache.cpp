@@ -1,0 +1,99 @@
+#include "volume/detail/brick_cache.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+namespace raysift::volume {
+
+namespace {
+int floor_div_block(int v) { return v >= 0 ? v >> kBlockLog2 : -((-v + kBlockSize - 1) >> kBlockLog2); }
+
+bool same_value(float a, float b) { return a == b || (std::isnan(a) && std::isnan(b)); }
+}  // namespace
+
+VolumeBricks build_volume_bricks_from_grid(const openvdb::FloatGrid& grid) {
+  using Tree = openvdb::FloatTree;
+  VolumeBricks out;
+  out.background = grid.background();
+  openvdb::CoordBBox bbox;
+  if (!grid.tree().evalActiveVoxelBoundingBox(bbox)) return out;
+  out.is_empty = false;
+  out.index_min = {bbox.min().x(), bbox.min().y(), bbox.min().z()};
+  out.index_max = {bbox.max().x(), bbox.max().y(), bbox.max().z()};
+  const Vec3i bmin{floor_div_block(out.index_min.x - 1), floor_div_block(out.index_min.y - 1),
+                   floor_div_block(out.index_min.z - 1)};
+  const Vec3i bmax{floor_div_block(out.index_max.x + 1), floor_div_block(out.index_max.y + 1),
+                   floor_div_block(out.index_max.z + 1)};
+  out.block_min = bmin;
+  out.dims = bmax - bmin + Vec3i{1, 1, 1};
+  const std::size_t count = std::size_t(out.dims.x) * out.dims.y * out.dims.z;
+  out.brick.assign(count, -1);
+  out.constant.assign(count, out.background);
+  out.lo.resize(count);
+  out.hi.resize(count);
+
+  auto for_each_block = [&](auto&& body) {
+    tbb::parallel_for(tbb::blocked_range<int>(0, out.dims.z), [&](const tbb::blocked_range<int>& r) {
+      openvdb::tree::ValueAccessor<const Tree, false> acc(grid.tree());
+      for (int k = r.begin(); k < r.end(); ++k)
+        for (int j = 0; j < out.dims.y; ++j)
+          for (int i = 0; i < out.dims.x; ++i)
+            body(acc, openvdb::Coord((bmin.x + i) * kBlockSize, (bmin.y + j) * kBlockSize, (bmin.z + k) * kBlockSize),
+                 (std::size_t(k) * out.dims.y + j) * out.dims.x + i);
+    });
+  };
+
+  // Pass 1: which blocks need a brick (a leaf, or differing tiles, anywhere in the 2×2×2 support).
+  std::vector<std::uint8_t> needs(count, 0);
+  for_each_block([&](auto& acc, const openvdb::Coord& origin, std::size_t idx) {
+    const float first = acc.getValue(origin);
+    for (int c = 0; c < 8; ++c) {
+      const openvdb::Coord o = origin.offsetBy((c >> 2) * kBlockSize, (c >> 1 & 1) * kBlockSize, (c & 1) * kBlockSize);
+      if (acc.probeConstLeaf(o) || !same_value(acc.getValue(o), first)) {
+        needs[idx] = 1;
+        return;
+      }
+    }
+    out.constant[idx] = first;
+  });
+  // Serial numbering keeps the layout independent of the thread count.
+  std::int32_t bricks = 0;
+  for (std::size_t i = 0; i < count; ++i)
+    if (needs[i]) out.brick[i] = bricks++;
+  out.values.resize(std::size_t(bricks) * kBrickVoxels);
+
+  // Pass 2: fill bricks (the own leaf is copied, the apron read through the accessor) and ranges.
+  for_each_block([&](auto& acc, const openvdb::Coord& origin, std::size_t idx) {
+    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    auto add = [&](float v) {
+      if (std::isnan(v)) return;
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    };
+    if (out.brick[idx] < 0) {
+      add(out.constant[idx]);
+    } else {
+      float* dst = out.values.data() + std::size_t(out.brick[idx]) * kBrickVoxels;
+      const Tree::LeafNodeType* leaf = acc.probeConstLeaf(origin);
+      const float* src = leaf ? leaf->buffer().data() : nullptr;
+      for (int x = 0; x < kBrickSide; ++x)
+        for (int y = 0; y < kBrickSide; ++y)
+          for (int z = 0; z < kBrickSide; ++z) {
+            const bool inside = src && x < kBlockSize && y < kBlockSize && z < kBlockSize;
+            const float v = inside ? src[(x << 6) | (y << 3) | z] : acc.getValue(origin.offsetBy(x, y, z));
+            dst[(x * kBrickSide + y) * kBrickSide + z] = v;
+            add(v);
+          }
+    }
+    out.lo[idx] = lo;
+    out.hi[idx] = hi;
+  });
+  return out;
+}
+
+}  // namespace raysift::volume
