@@ -1,0 +1,233 @@
+// raysift mesh: iso-surfaces of a volume as one triangle mesh. Flow: parse -> load volume and TF -> choose
+// iso-values (histogram peaks + TF opacity maxima, or --iso) -> marching cubes (one surface per value) ->
+// Taubin -> decimate -> Taubin per surface -> write all surfaces into one mesh file -> stats.
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "apps/raysift/command.h"
+#include "core/errors.h"
+#include "core/file_util.h"
+#include "core/scene.h"
+#include "core/timer.h"
+#include "mesh/mesh_analysis.h"
+#include "mesh/mesh_io.h"
+#include "mesh/mesh_prep.h"
+#include "volume/iso_values.h"
+#include "volume/marching_cubes.h"
+#include "volume/transfer_function.h"
+#include "volume/vdb_io.h"
+
+namespace raysift::app {
+namespace {
+
+struct MeshCliOptions {
+  std::string volume, grid, tf, out, iso;
+  bool tf_normalized = false;
+  int max_surfaces = volume::IsoValueOptions{}.max_surfaces;
+  int smooth = mesh::SmoothingOptions{}.iterations;
+  double lambda = mesh::SmoothingOptions{}.lambda;
+  double mu = mesh::SmoothingOptions{}.mu;
+  bool cotangent = false;
+  double decimate = mesh::DecimationOptions{}.ratio;
+  long long faces = 0;
+  double max_error = 0;
+  bool flip = false;
+};
+
+std::vector<double> parse_iso_list(const std::string& text) {
+  std::vector<double> values;
+  std::stringstream s(text);
+  std::string item;
+  while (std::getline(s, item, ',')) {
+    double v = NAN;
+    try {
+      std::size_t used = 0;
+      v = std::stod(item, &used);
+      if (used != item.size()) v = NAN;
+    } catch (const std::exception&) {
+    }
+    if (!std::isfinite(v)) bad_flag("--iso", "a comma-separated list of finite numbers", text);
+    values.push_back(v);
+  }
+  if (values.empty()) bad_flag("--iso", "a comma-separated list of finite numbers", text);
+  return values;
+}
+
+void validate(const MeshCliOptions& o, CLI::App& sub) {
+  const std::string ext = file_extension(o.out);
+  if (ext != ".ply" && ext != ".obj" && ext != ".off") bad_flag("-o/--out", "a .ply, .obj or .off path", o.out);
+  if (o.max_surfaces < 1) bad_flag("--max-surfaces", ">= 1", std::to_string(o.max_surfaces));
+  if (o.smooth < 0) bad_flag("--smooth", ">= 0 iterations (0 = off)", std::to_string(o.smooth));
+  if (!(o.lambda > 0 && o.lambda <= 1)) bad_flag("--lambda", "in (0, 1]", std::to_string(o.lambda));
+  if (!(o.mu < -o.lambda && o.mu >= -1))
+    bad_flag("--mu", "in [-1, -lambda) (Taubin inflation step)", std::to_string(o.mu));
+  if (!(o.decimate > 0 && o.decimate <= 1)) bad_flag("--decimate", "a face ratio in (0, 1] (1 = off)", std::to_string(o.decimate));
+  if (sub.count("--decimate") && sub.count("--faces")) throw UsageError("--decimate and --faces are exclusive; see --help");
+  if (o.faces < 0 || (sub.count("--faces") && o.faces < 4)) bad_flag("--faces", ">= 4", std::to_string(o.faces));
+  if (!(o.max_error >= 0) || !std::isfinite(o.max_error))
+    bad_flag("--max-error", ">= 0 world units (0 = unbounded)", std::to_string(o.max_error));
+}
+
+Json stage_json(const mesh::StageReport& s) { return {{"ms", s.ms}, {"triangles", s.triangles}}; }
+
+void run(const MeshCliOptions& o, const CommonOptions& common, CLI::App& sub) {
+  validate(o, sub);
+  Scene scene;
+  if (!common.scene_path.empty()) scene = load_scene(common.scene_path);
+  const std::string volume_path = !o.volume.empty() ? o.volume : scene.volume;
+  if (volume_path.empty()) throw UsageError("mesh needs a VOLUME argument or a --scene with a 'volume'; see --help");
+  const volume::Volume vol = volume::load_vdb(volume_path, !o.grid.empty() ? o.grid : scene.grid);
+  const volume::GridInfo info = vol.info();
+
+  volume::TfJsonOptions tf_options;
+  tf_options.normalized = o.tf_normalized;
+  tf_options.data_min = info.value_min;
+  tf_options.data_max = info.value_max;
+  std::unique_ptr<volume::TransferFunction> tf;
+  std::string tf_source = o.tf;
+  if (!o.tf.empty()) {
+    tf = std::make_unique<volume::TransferFunction>(volume::load_transfer_function(o.tf, tf_options));
+  } else if (!scene.transfer_function.is_null()) {
+    tf_source = scene.transfer_function_source;
+    tf = std::make_unique<volume::TransferFunction>(
+        volume::transfer_function_from_json(scene.transfer_function, tf_source, tf_options));
+  } else if (o.iso.empty()) {
+    throw UsageError("mesh needs --tf TF.json (or a --scene with a 'transfer_function') or --iso; see --help");
+  }
+
+  std::vector<volume::IsoValue> isos;
+  if (tf) {
+    volume::IsoValueOptions iso_options;
+    iso_options.max_surfaces = o.max_surfaces;
+    try {
+      isos = volume::select_iso_values(vol, *tf, iso_options);
+    } catch (const InvalidInput& e) {
+      throw InvalidInput(file_message(tf_source, std::string(e.what()) + "; nothing written"));
+    }
+  }
+  if (!o.iso.empty()) {
+    isos.clear();
+    for (const double v : parse_iso_list(o.iso)) {
+      if (v < info.value_min || v > info.value_max) {
+        std::ostringstream range;
+        range << "within the data range [" << info.value_min << ", " << info.value_max << "] of grid '" << info.name << "'";
+        bad_flag("--iso", range.str(), std::to_string(v));
+      }
+      isos.push_back({v, "given with --iso"});
+    }
+  }
+  if (!common.quiet)
+    for (const auto& iso : isos) std::cout << "iso-value " << iso.value << ": " << iso.reason << "\n";
+
+  std::vector<double> iso_values;
+  for (const auto& iso : isos) iso_values.push_back(iso.value);
+  volume::MarchingCubesOptions mc_options;
+  mc_options.flip_orientation = o.flip;
+  Timer mc_timer;
+  const std::vector<mesh::TriMesh> surfaces = volume::extract_isosurfaces(vol, iso_values, mc_options);
+  const double mc_ms = mc_timer.elapsed_ms();
+  std::size_t mc_triangles = 0;
+  for (const auto& s : surfaces) mc_triangles += s.triangle_count();
+
+  mesh::MeshPrepOptions prep;
+  prep.smooth_before.iterations = prep.smooth_after.iterations = o.smooth;
+  prep.smooth_before.lambda = prep.smooth_after.lambda = o.lambda;
+  prep.smooth_before.mu = prep.smooth_after.mu = o.mu;
+  prep.smooth_before.weights = prep.smooth_after.weights =
+      o.cotangent ? mesh::SmoothingWeights::Cotangent : mesh::SmoothingWeights::Uniform;
+  prep.decimation.ratio = o.decimate;
+  prep.decimation.max_error = o.max_error;
+
+  mesh::TriMesh combined;
+  mesh::StageReport smooth_before, decimate, smooth_after;
+  Json surface_stats = Json::array();
+  for (std::size_t i = 0; i < surfaces.size(); ++i) {
+    if (surfaces[i].empty()) {
+      if (!common.quiet) std::cerr << "raysift: warning: iso-value " << iso_values[i] << " gives an empty surface\n";
+      surface_stats.push_back({{"triangles", 0}, {"vertices", 0}, {"watertight", false}, {"euler_characteristic", 0}, {"area", 0.0}});
+      continue;
+    }
+    if (o.faces > 0)  // --faces is a total; each surface gets its share of the marching-cubes triangles
+      prep.decimation.target_faces = std::min<std::size_t>(
+          surfaces[i].triangle_count(),
+          std::max<std::size_t>(4, std::size_t(std::llround(double(o.faces) * double(surfaces[i].triangle_count()) /
+                                                             double(mc_triangles)))));
+    const mesh::MeshPrepResult r = mesh::prepare_mesh(surfaces[i], prep);
+    smooth_before.ms += r.smooth_before.ms;
+    smooth_before.triangles += r.smooth_before.triangles;
+    decimate.ms += r.decimate.ms;
+    decimate.triangles += r.decimate.triangles;
+    smooth_after.ms += r.smooth_after.ms;
+    smooth_after.triangles += r.smooth_after.triangles;
+    if (!r.decimation_reached_target && !common.quiet)
+      std::cerr << "raysift: warning: surface " << iso_values[i] << ": --max-error stopped decimation at "
+                << r.mesh.triangle_count() << " triangles\n";
+
+    const mesh::MeshAnalysis a = mesh::analyze_mesh(r.mesh);
+    Json s = {{"triangles", a.faces},
+              {"vertices", a.vertices},
+              {"watertight", a.is_watertight()},
+              {"euler_characteristic", a.euler_characteristic},
+              {"area", a.area}};
+    if (a.is_watertight()) s["enclosed_volume"] = a.signed_volume;
+    surface_stats.push_back(s);
+
+    const auto offset = std::uint32_t(combined.positions.size());
+    combined.positions.insert(combined.positions.end(), r.mesh.positions.begin(), r.mesh.positions.end());
+    for (const auto& t : r.mesh.triangles) combined.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  }
+  if (combined.empty())
+    throw InvalidInput(file_message(volume_path, "no iso-surface found at the chosen iso-values; nothing written"));
+  mesh::write_mesh(o.out, combined);
+
+  if (common.verbose)
+    std::cerr << "marching cubes " << mc_ms << " ms (" << mc_triangles << " triangles), smooth " << smooth_before.ms
+              << " ms, decimate " << decimate.ms << " ms (" << decimate.triangles << " triangles), smooth "
+              << smooth_after.ms << " ms\n";
+  if (!common.quiet)
+    std::cout << "wrote " << o.out << ": " << surfaces.size() << " surface(s), " << combined.triangle_count()
+              << " triangles\n";
+  const Json stats = {{"iso_values", iso_values},
+                      {"surfaces", surface_stats},
+                      {"stages",
+                       {{"marching_cubes", stage_json({mc_ms, mc_triangles})},
+                        {"smooth_before", stage_json(smooth_before)},
+                        {"decimate", stage_json(decimate)},
+                        {"smooth_after", stage_json(smooth_after)}}}};
+  write_stats_if_requested(common, stats);
+}
+
+RegisterCommand reg(
+    "mesh", "iso-surfaces of a volume: iso-values from the TF, marching cubes, Taubin smoothing, decimation",
+    [](CLI::App& sub, CommonOptions& common) -> RunFunction {
+      auto opt = std::make_shared<MeshCliOptions>();
+      sub.add_option("VOLUME", opt->volume, "input .vdb (default: the scene's volume)");
+      sub.add_option("-o,--out", opt->out, "output mesh (.ply binary, .obj, .off); all surfaces in one file")->required();
+      sub.add_option("--grid", opt->grid, "grid name (default: the scene's, else the first float grid)");
+      sub.add_option("--tf", opt->tf, "transfer function JSON; picks the iso-values (see docs/isosurface.md)");
+      sub.add_flag("--tf-normalized", opt->tf_normalized, "TF x values are 0..1 over the data range");
+      sub.add_option("--iso", opt->iso, "iso-values V1,V2,... (overrides the TF's choice)");
+      sub.add_option("--max-surfaces", opt->max_surfaces, "at most this many TF-chosen iso-values, >= 1")
+          ->capture_default_str();
+      sub.add_option("--smooth", opt->smooth, "Taubin iterations before and after decimation, >= 0 (0 = off)")
+          ->capture_default_str();
+      sub.add_option("--lambda", opt->lambda, "Taubin shrink step, (0, 1]")->capture_default_str();
+      sub.add_option("--mu", opt->mu, "Taubin inflate step, [-1, -lambda)")->capture_default_str();
+      sub.add_flag("--cotangent", opt->cotangent, "cotangent instead of uniform smoothing weights");
+      sub.add_option("--decimate", opt->decimate, "keep this fraction of the faces, (0, 1] (1 = off)")
+          ->capture_default_str();
+      sub.add_option("--faces", opt->faces, "total face target instead of --decimate, split over the surfaces");
+      sub.add_option("--max-error", opt->max_error,
+                     "decimation distance bound in world units (0 = unbounded)")->capture_default_str();
+      sub.add_flag("--flip", opt->flip, "normals toward increasing values (default: toward decreasing)");
+      sub.footer(
+          "Examples:\n"
+          "  raysift mesh engine.vdb --tf engine_tf.json -o engine.ply --stats mesh_stats.json\n"
+          "  raysift mesh engine.vdb --iso 80.5,150.5 --smooth 20 --faces 100000 -o engine.obj");
+      return [opt, &common, &sub] { run(*opt, common, sub); };
+    });
+
+}  // namespace
+}  // namespace raysift::app
