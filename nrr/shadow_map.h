@@ -58,17 +58,23 @@ class ShadowMap {
   bool is_lit(const Vec3d& p_ws, const Vec3d& normal, const ShadowBias& bias) const;
 
   const ShadowFrustum& frustum() const { return frustum_; }
-  /// Row-major resolution x resolution view depths, +inf where empty.
-  const std::vector<float>& depth() const { return depth_; }
-  /// Triangles rasterised by the last render() (after clipping, before coverage).
+  /// Row-major resolution x resolution inverse view depths 1/z (world units^-1), 0 where empty.
+  /// Storing 1/z saves a division per covered texel: it is what the rasteriser interpolates.
+  const std::vector<float>& inverse_depth() const { return inv_depth_; }
+  /// Triangles of the last render() whose bounding box contained a texel centre (after clipping).
   std::size_t rasterised_triangle_count() const { return rasterised_; }
 
  private:
   void rasterise(const double (&sx)[3], const double (&sy)[3], const double (&inv_z)[3]);
 
+  struct ProjectedVertex {
+    Vec3d frame;                  ///< light-frame coordinates (right, up, forward)
+    double sx = 0, sy = 0, inv_z = 0;  ///< texel coordinates and 1/z, valid when frame.z >= z_near
+  };
+
   ShadowFrustum frustum_;
-  std::vector<float> depth_;
-  std::vector<Vec3f> frame_;  ///< per-vertex light-frame coordinates of the mesh being drawn
+  std::vector<float> inv_depth_;
+  std::vector<ProjectedVertex> vertices_;  ///< scratch: the vertices of the mesh being drawn
   std::size_t rasterised_ = 0;
 };
 

@@ -266,6 +266,27 @@ std::vector<CameraSpec> light_corner_views(const AreaLight& light, const Bbox3d&
   return views;
 }
 
+CameraSpec default_shadow_camera(const AreaLight& light, const Bbox3d& bounds, int width, int height) {
+  RAYSIFT_CHECK(!bounds.is_empty());
+  const Vec3d centre = bounds.center();
+  const double diag = std::max(bounds.diagonal(), 1e-12);
+  Vec3d axis = light.is_point() ? normalize(centre - light.center) : light.normal();  // toward the scene
+  if (length(axis) == 0.0) axis = Vec3d{0, -1, 0};
+  const Vec3d side = any_perpendicular(axis);
+  const double off = 35.0 * M_PI / 180.0;
+  const Vec3d view = normalize(axis * std::cos(off) + side * std::sin(off));  // eye -> centre
+  CameraSpec c;
+  c.eye = centre - view * (1.2 * diag);
+  c.target = centre;
+  c.up = -axis;
+  c.width = width;
+  c.height = height;
+  // The box's bounding sphere (radius diag/2) seen from 1.2 diag: half-angle asin(0.5/1.2) ~ 24.6 deg.
+  const double tan_half = std::tan(std::asin(0.5 / 1.2)) * std::max(1.0, double(height) / double(width));
+  c.fov_y_deg = std::min(2.0 * std::atan(tan_half) * 180.0 / M_PI, 150.0);
+  return c;
+}
+
 ShadowResult render_shadows(const mesh::TriMesh& mesh, const SampledScene& scene, const Receivers& receivers,
                             const AreaLight& light, ShadowMethod method, const ShadowOptions& options) {
   validate(options);

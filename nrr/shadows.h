@@ -100,6 +100,11 @@ VisibilitySet shadow_map_visibility(Span<const mesh::TriMesh* const> occluders, 
                                     const Receivers& receivers, Span<const Vec3d> samples_ws, const AreaLight& light,
                                     const ShadowOptions& options);
 
+/// An output view of the scene from the light's side: eye 35 degrees off the light's axis (the axis
+/// from the light centre to the box centre for a point light) at 1.2 box diagonals from the box
+/// centre, field of view enclosing the box. Used when no camera is given.
+CameraSpec default_shadow_camera(const AreaLight& light, const Bbox3d& bounds, int width, int height);
+
 /// Runs one method end to end (depth images, reconstruction, shadow maps where the method has them).
 /// `scene` must have been built from `mesh`.
 /// \throw InvalidInput if the light emits toward none of the scene's bounding-box corners ("the light
