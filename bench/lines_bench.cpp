@@ -1,49 +1,61 @@
-// Importance-buffer cost vs one primary Embree ray per pixel on the same mesh, same view, same run.
-// The RP paper's condition: the importance buffer must cost far less than the rays it saves. Until the
-// full volume render is the reference, the reference is tracing every primary ray against the mesh.
+// Importance-buffer cost (all line classes, including hidden-line removal and rasterisation, excluding the
+// view-independent curvature) against references measured in the same run, on the same view:
+//  * the engine CT (datasets/engine_ct.vdb, its TF and 1440x900 camera): its iso-surface mesh (first
+//    iso-value selected from the TF and histogram, raw marching cubes) vs the full-quality volume render
+//    (the RP paper's condition: at most 10 %) and vs one primary Embree ray per pixel against the mesh;
+//  * a mesh file (default: the Stanford bunny beside the clone) at 1440x900 vs one primary Embree ray per
+//    pixel.
+// Rounds interleave the measured stage and its references, so a change in machine load affects both sides.
 //
-// Usage: lines_bench [MESH] [WIDTHxHEIGHT]   (default: the Stanford bunny beside the clone, 1440x900)
+// Usage: lines_bench [MESH]
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include "core/camera.h"
+#include "core/json_io.h"
 #include "core/timer.h"
 #include "features/importance.h"
 #include "mesh/curvature.h"
 #include "mesh/mesh_io.h"
 #include "mesh/ray_scene.h"
+#include "volume/iso_values.h"
+#include "volume/marching_cubes.h"
+#include "volume/raycaster.h"
+#include "volume/transfer_function.h"
+#include "volume/vdb_io.h"
 
 using namespace raysift;
 
 namespace {
 
+/// Wall and CPU time (process time of all threads). CPU time is printed too because the machine may be
+/// shared: wall time then depends on the load, CPU time much less.
 struct Cost {
-  double wall_ms, cpu_ms;  // medians over the runs; CPU = process time of all threads
-};
-
-/// Medians of wall and CPU time. CPU time is reported too because the machine may be shared: wall time
-/// then depends on the load, CPU time much less.
-template <typename F>
-Cost median_cost(int runs, const F& f) {
-  std::vector<double> wall, cpu;
-  for (int i = 0; i < runs; ++i) {
+  std::vector<double> wall_ms, cpu_ms;
+  template <typename F>
+  void measure(const F& f) {
     const std::clock_t c0 = std::clock();
     Timer timer;
     f();
-    wall.push_back(timer.elapsed_ms());
-    cpu.push_back(1000.0 * double(std::clock() - c0) / CLOCKS_PER_SEC);
+    wall_ms.push_back(timer.elapsed_ms());
+    cpu_ms.push_back(1000.0 * double(std::clock() - c0) / CLOCKS_PER_SEC);
   }
-  std::sort(wall.begin(), wall.end());
-  std::sort(cpu.begin(), cpu.end());
-  return {wall[wall.size() / 2], cpu[cpu.size() / 2]};
-}
+  static double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  }
+  double wall() const { return median(wall_ms); }
+  double cpu() const { return median(cpu_ms); }
+};
 
 /// One primary ray per pixel, 16x16 tiles in parallel, batched through RayScene's packet path.
 std::size_t trace_primary_rays(const mesh::RayScene& scene, const Camera& cam) {
@@ -51,6 +63,7 @@ std::size_t trace_primary_rays(const mesh::RayScene& scene, const Camera& cam) {
   tbb::parallel_for(tbb::blocked_range2d<int>(0, cam.height(), 16, 0, cam.width(), 16),
                     [&](const tbb::blocked_range2d<int>& r) {
     std::vector<mesh::RayF> rays;
+    rays.reserve(std::size_t(r.rows().size() * r.cols().size()));
     for (int y = r.rows().begin(); y != r.rows().end(); ++y)
       for (int x = r.cols().begin(); x != r.cols().end(); ++x) {
         const Ray ray = cam.ray(x + 0.5, y + 0.5);
@@ -68,27 +81,14 @@ std::size_t trace_primary_rays(const mesh::RayScene& scene, const Camera& cam) {
   return std::size_t(std::count(hit.begin(), hit.end(), 1));
 }
 
-}  // namespace
+void print_row(const char* name, const Cost& c, const std::string& note) {
+  std::printf("  %-36s %9.2f %9.2f   %s\n", name, c.wall(), c.cpu(), note.c_str());
+}
 
-int main(int argc, char** argv) {
-  const std::string path =
-      argc > 1 ? argv[1] : RAYSIFT_SOURCE_DIR "/../shared/datasets/stanford_bunny_bun_zipper_35947v_69451tri.ply";
-  int width = 1440, height = 900;
-  if (argc > 2 && std::sscanf(argv[2], "%dx%d", &width, &height) != 2) {
-    std::fprintf(stderr, "lines_bench: size must be WIDTHxHEIGHT, got %s\n", argv[2]);
-    return 2;
-  }
-  const mesh::TriMesh m = mesh::read_mesh(path);
-  Bbox3d box;
-  for (const Vec3f& p : m.positions) box.expand(Vec3d(p));
-  CameraSpec spec;
-  spec.width = width;
-  spec.height = height;
-  spec.fov_y_deg = 30.0;
-  spec.target = box.center();
-  spec.eye = box.center() + Vec3d{0.3, 0.2, 1.0} * (1.2 * box.diagonal() / std::sin(15.0 * M_PI / 180.0) / 2);
-  const Camera cam(spec);
-
+/// Measures the importance buffer and the Embree reference (and `extra`, if given) on one mesh and view.
+template <typename Extra>
+void run_case(const char* title, const mesh::TriMesh& m, const Camera& cam, const features::BackgroundGeometry& bg,
+              const Extra& extra) {
   Timer timer;
   const mesh::MeshCurvature curvature = mesh::compute_curvature(m);
   const double curvature_ms = timer.elapsed_ms();
@@ -96,28 +96,97 @@ int main(int argc, char** argv) {
   const mesh::RayScene scene(m);
   const double bvh_ms = timer.elapsed_ms();
 
-  const int runs = 7;
-  features::BackgroundGeometry bg;
-  bg.mesh = &m;
   features::LineOptions all;  // every class
+  features::ImportanceOptions io;
   features::ImportanceTimings stages;
   features::FeatureLines visible;
-  compute_importance(m, curvature, cam, all, bg, {}, &visible, &stages);  // warm-up
-  const Cost importance =
-      median_cost(runs, [&] { features::compute_importance(m, curvature, cam, all, bg, {}, &visible, &stages); });
-  std::size_t hits = trace_primary_rays(scene, cam);  // warm-up
-  const Cost rays = median_cost(runs, [&] { hits = trace_primary_rays(scene, cam); });
+  features::ImportanceBuffer buffer;
+  std::size_t hits = 0;
+  Cost importance, rays;
+  const int rounds = 5;
+  for (int round = 0; round < rounds; ++round) {
+    importance.measure([&] { buffer = features::compute_importance(m, curvature, cam, all, bg, io, &visible, &stages); });
+    rays.measure([&] { hits = trace_primary_rays(scene, cam); });
+    extra.measure_once();
+  }
+  std::printf("%s: %zu triangles, view %dx%d, importance buffer %dx%d, %d threads\n", title, m.triangle_count(),
+              cam.width(), cam.height(), buffer.values.width, buffer.values.height,
+              tbb::this_task_arena::max_concurrency());
+  std::printf("  view-independent, excluded: curvature %.1f ms, Embree BVH %.1f ms\n", curvature_ms, bvh_ms);
+  std::printf("  %-36s %9s %9s   (medians of %d rounds)\n", "stage", "wall ms", "CPU ms", rounds);
+  char note[200];
+  std::snprintf(note, sizeof note, "last: lines %.1f, visibility %.1f, raster %.1f ms; %zu visible pieces",
+                stages.lines_ms, stages.visibility_ms, stages.raster_ms, visible.segments.size());
+  print_row("importance buffer (all classes)", importance, note);
+  print_row("one primary Embree ray per pixel", rays, std::to_string(hits) + " hits");
+  std::printf("  %-36s %9.3f %9.3f\n", "ratio importance / primary rays", importance.wall() / rays.wall(),
+              importance.cpu() / rays.cpu());
+  extra.report(importance);
+}
 
-  std::printf("mesh: %s (%zu triangles), view %dx%d, importance buffer %dx%d\n", path.c_str(), m.triangle_count(),
-              width, height, int(std::lround(width * 0.5)), int(std::lround(height * 0.5)));
-  std::printf("view-independent (excluded): curvature %.1f ms, Embree BVH %.1f ms\n", curvature_ms, bvh_ms);
-  std::printf("medians of %d runs                    wall ms    CPU ms\n", runs);
-  std::printf("importance buffer, all classes     %9.2f %9.2f   [last run: lines %.2f, visibility %.2f, raster "
-              "%.2f ms wall; %zu visible pieces]\n",
-              importance.wall_ms, importance.cpu_ms, stages.lines_ms, stages.visibility_ms, stages.raster_ms,
-              visible.segments.size());
-  std::printf("one primary Embree ray per pixel   %9.2f %9.2f   [%zu hits]\n", rays.wall_ms, rays.cpu_ms, hits);
-  std::printf("ratio importance / primary rays    %9.3f %9.3f\n", importance.wall_ms / rays.wall_ms,
-              importance.cpu_ms / rays.cpu_ms);
-  return 0;
+struct NoExtra {
+  void measure_once() const {}
+  void report(const Cost&) const {}
+};
+
+/// The full-quality volume render of the same view, the real reference.
+struct FullRender {
+  const volume::RayCaster& caster;
+  mutable Cost cost;
+  mutable std::uint64_t rays = 0;
+  void measure_once() const {
+    cost.measure([&] { rays = volume::render_full(caster).rays_traced; });
+  }
+  void report(const Cost& importance) const {
+    print_row("full volume render (reference)", cost, std::to_string(rays) + " rays");
+    std::printf("  %-36s %8.2f%% %8.2f%%   (target <= 10 %%)\n", "importance / full render",
+                100.0 * importance.wall() / cost.wall(), 100.0 * importance.cpu() / cost.cpu());
+  }
+};
+
+void engine_case() {
+  const std::string dir = std::string(RAYSIFT_SOURCE_DIR) + "/datasets/";
+  if (!std::filesystem::exists(dir + "engine_ct.vdb")) {
+    std::printf("engine CT: %sengine_ct.vdb not found, skipped\n", dir.c_str());
+    return;
+  }
+  const volume::Volume vol = volume::load_vdb(dir + "engine_ct.vdb");
+  const volume::TransferFunction tf = volume::load_transfer_function(dir + "engine_ct_tf.json");
+  const CameraSpec spec = camera_spec_from_json(read_json_file(dir + "engine_ct_camera.json"), "engine camera");
+  const double iso = volume::select_iso_values(vol, tf).front().value;
+  const mesh::TriMesh m = volume::extract_isosurface(vol, iso);
+  const volume::GridInfo info = vol.info();
+  features::BackgroundGeometry bg;
+  bg.bbox_ws = Bbox3d{info.bbox_min - info.voxel_size * 0.5, info.bbox_max + info.voxel_size * 0.5};
+  const volume::RayCaster caster(vol, tf, spec);
+  char title[160];
+  std::snprintf(title, sizeof title, "engine CT iso-surface (iso %.1f, raw marching cubes)", iso);
+  run_case(title, m, Camera(spec), bg, FullRender{caster, {}});
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    engine_case();
+    const std::string path =
+        argc > 1 ? argv[1] : RAYSIFT_SOURCE_DIR "/../shared/datasets/stanford_bunny_bun_zipper_35947v_69451tri.ply";
+    const mesh::TriMesh m = mesh::read_mesh(path);
+    Bbox3d box;
+    for (const Vec3f& p : m.positions) box.expand(Vec3d(p));
+    CameraSpec spec;
+    spec.width = 1440;
+    spec.height = 900;
+    spec.fov_y_deg = 30.0;
+    spec.target = box.center();
+    // The whole mesh in view from the front, slightly above and to the side.
+    spec.eye = box.center() + normalize(Vec3d{0.3, 0.2, 1.0}) * (0.6 * box.diagonal() / std::sin(15.0 * M_PI / 180.0));
+    features::BackgroundGeometry bg;
+    bg.mesh = &m;
+    run_case(path.c_str(), m, Camera(spec), bg, NoExtra{});
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "lines_bench: error: %s\n", e.what());
+    return 1;
+  }
 }

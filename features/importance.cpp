@@ -9,11 +9,16 @@
 
 #include "core/errors.h"
 #include "core/timer.h"
+#include "features/detail/distance_transform.h"
 #include "features/detail/segment_raster.h"
 #include "features/raster.h"
 
 namespace raysift::features {
 namespace {
+
+/// A pixel is on a line when its centre lies within this distance of it (half the pixel diagonal, so a
+/// line marks every pixel it passes through).
+constexpr double kLineCorePx = 0.7072;
 
 void validate(const ImportanceOptions& o, const BackgroundGeometry& bg) {
   if (!(o.scale > 0 && o.scale <= 1))
@@ -105,16 +110,28 @@ ImportanceBuffer rasterize(const FeatureLines& visible, const Camera& frame, con
     if (!a || !b) continue;
     segs.push_back({a->x_ss * sx, a->y_ss * sy, b->x_ss * sx, b->y_ss * sy, std::uint32_t(i)});
   }
-  // Line core: pixel centres within half a pixel; then a smoothstep fall-off to 0 over falloff_px.
-  const double core = 0.5, falloff = o.falloff_px * o.scale;
-  detail::for_each_pixel_near_segments(w, h, segs, core + falloff, o.threaded,
-                                       [&](int x, int y, double d, const detail::Segment2& s) {
-    const double u = std::clamp((d - core) / falloff, 0.0, 1.0);
-    const double f = 1.0 - u * u * (3.0 - 2.0 * u);
-    const float value = float(o.priority[std::size_t(visible.segments[s.index].line_class)] * f);
-    float& cur = out.values(x, y);
-    cur = std::max(cur, value);
-  });
+  // Per priority level: seed the pixels the level's lines pass through, take the exact distance transform,
+  // and apply the fall-off; the per-pixel max over levels equals the max over individual lines because
+  // the fall-off is monotone. Cost: linear in pixels per level, independent of the number of lines.
+  std::vector<float> levels;
+  for (const detail::Segment2& s : segs) levels.push_back(o.priority[std::size_t(visible.segments[s.index].line_class)]);
+  std::sort(levels.begin(), levels.end());
+  levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
+  const double falloff = o.falloff_px * o.scale;
+  for (float level : levels) {
+    std::vector<detail::Segment2> level_segs;
+    for (const detail::Segment2& s : segs)
+      if (o.priority[std::size_t(visible.segments[s.index].line_class)] == level) level_segs.push_back(s);
+    Image<std::uint8_t> seeds(w, h, 0);
+    detail::for_each_pixel_near_segments(w, h, level_segs, kLineCorePx, o.threaded,
+                                         [&](int x, int y, double, const detail::Segment2&) { seeds(x, y) = 1; });
+    const ImageF d2 = detail::squared_distance_transform(seeds, o.threaded);
+    for_pixels(w, h, o.threaded, [&](int x, int y) {
+      const double u = std::clamp((std::sqrt(double(d2(x, y))) - 0.5) / falloff, 0.0, 1.0);
+      float& cur = out.values(x, y);
+      cur = std::max(cur, float(level * (1.0 - u * u * (3.0 - 2.0 * u))));
+    });
+  }
 
   if (bg.bbox_ws || bg.mesh) {
     const Image<std::uint8_t> hit = coverage(cam, bg, mesh_frame_depth, o.threaded);

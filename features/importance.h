@@ -7,10 +7,13 @@
 /// neighbours miss), so upsampling never marks a frame pixel that sees the geometry as background.
 ///
 /// Value contract (ImportanceBuffer::values):
-///  * line pixels (centre within 0.5 px of a visible line) hold their class priority
-///    (ImportanceOptions::priority; default 1.0 contours and exterior silhouettes, 0.6 the rest);
-///  * around a line the value falls off smoothly and monotonically with distance, reaching 0 at
-///    `falloff_px` (frame pixels); where classes overlap the per-pixel maximum wins;
+///  * line pixels (the buffer pixels a visible line passes through: centre within 0.71 px of it) hold
+///    their class priority (ImportanceOptions::priority; default 1.0 contours and exterior silhouettes,
+///    0.6 the rest);
+///  * around a line the value falls off smoothly (smoothstep) and monotonically with the distance d to
+///    the nearest line pixel (Euclidean distance transform): priority · (1 − smoothstep((d − 0.5) / r)),
+///    r = falloff_px · scale, so it reaches 0 at 0.5 + r buffer pixels; where classes overlap the per-pixel
+///    maximum wins;
 ///  * other object / volume pixels hold 0;
 ///  * background pixels hold `background_value` (< 0, default -1). With no background geometry given
 ///    no pixel is background.

@@ -69,23 +69,55 @@ DepthBuffer rasterize_depth(const mesh::TriMesh& mesh, const Camera& camera, con
   const double tan_y = std::tan(camera.spec().fov_y_deg * M_PI / 360.0);
   const double tan_x = tan_y * double(width) / double(height);
 
+  // Vertices in view space and, when in front of the near plane, on screen (once per vertex).
   std::vector<ViewPoint> view(mesh.vertex_count());
+  struct ScreenPoint {
+    double x, y, inv_z;
+  };
+  std::vector<ScreenPoint> screen(mesh.vertex_count());
+  auto to_screen = [&](const ViewPoint& p) {
+    return ScreenPoint{(p.x / p.z / tan_x + 1.0) * 0.5 * width, (1.0 - p.y / p.z / tan_y) * 0.5 * height, 1.0 / p.z};
+  };
   for_chunks(view.size(), 8192, options.threaded, [&](std::size_t, std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       const Vec3d d = Vec3d(mesh.positions[i]) - camera.eye();
       view[i] = {dot(d, camera.right()), dot(d, camera.image_up()), dot(d, camera.forward())};
+      if (view[i].z >= near) screen[i] = to_screen(view[i]);
     }
   });
 
-  // Clip each triangle at the near plane (Sutherland-Hodgman against one plane) and project it.
+  // Triangles crossing the near plane are clipped (Sutherland-Hodgman against one plane) and fanned.
   constexpr std::size_t kChunk = 8192;
   std::vector<std::vector<ScreenTri>> parts((mesh.triangle_count() + kChunk - 1) / kChunk);
   for_chunks(mesh.triangle_count(), kChunk, options.threaded, [&](std::size_t c, std::size_t b, std::size_t e) {
+    auto add = [&](const ScreenPoint* p0, const ScreenPoint* p1, const ScreenPoint* p2, std::uint32_t face) {
+      ScreenTri st;
+      st.face = face;
+      const ScreenPoint* corner[3] = {p0, p1, p2};
+      for (int j = 0; j < 3; ++j) {
+        st.x[j] = corner[j]->x;
+        st.y[j] = corner[j]->y;
+        st.inv_z[j] = corner[j]->inv_z;
+      }
+      // Pixel centres (i + 0.5) inside the bounds; triangles that cover none are dropped here.
+      const double x0 = std::min({st.x[0], st.x[1], st.x[2]}), x1 = std::max({st.x[0], st.x[1], st.x[2]});
+      const double y0 = std::min({st.y[0], st.y[1], st.y[2]}), y1 = std::max({st.y[0], st.y[1], st.y[2]});
+      st.c0 = int(std::max(0.0, std::ceil(x0 - 0.5)));
+      st.c1 = int(std::min(double(width - 1), std::floor(x1 - 0.5)));
+      st.r0 = int(std::max(0.0, std::ceil(y0 - 0.5)));
+      st.r1 = int(std::min(double(height - 1), std::floor(y1 - 0.5)));
+      if (st.c0 <= st.c1 && st.r0 <= st.r1) parts[c].push_back(st);
+    };
     for (std::size_t f = b; f < e; ++f) {
       const auto& t = mesh.triangles[f];
+      const int in_front = int(view[t[0]].z >= near) + int(view[t[1]].z >= near) + int(view[t[2]].z >= near);
+      if (in_front == 3) {
+        add(&screen[t[0]], &screen[t[1]], &screen[t[2]], std::uint32_t(f));
+        continue;
+      }
       ViewPoint poly[4];
       int n = 0;
-      for (int k = 0; k < 3; ++k) {
+      for (int k = 0; k < 3 && in_front > 0; ++k) {
         const ViewPoint& p = view[t[k]];
         const ViewPoint& q = view[t[(k + 1) % 3]];
         if (p.z >= near) poly[n++] = p;
@@ -94,24 +126,9 @@ DepthBuffer rasterize_depth(const mesh::TriMesh& mesh, const Camera& camera, con
           poly[n++] = {p.x + s * (q.x - p.x), p.y + s * (q.y - p.y), near};
         }
       }
-      for (int k = 1; k + 1 < n; ++k) {
-        ScreenTri st;
-        st.face = std::uint32_t(f);
-        const ViewPoint* corner[3] = {&poly[0], &poly[k], &poly[k + 1]};
-        for (int j = 0; j < 3; ++j) {
-          st.x[j] = (corner[j]->x / corner[j]->z / tan_x + 1.0) * 0.5 * width;
-          st.y[j] = (1.0 - corner[j]->y / corner[j]->z / tan_y) * 0.5 * height;
-          st.inv_z[j] = 1.0 / corner[j]->z;
-        }
-        // Pixel centres (i + 0.5) inside the bounds; triangles that cover none are dropped here.
-        const double x0 = std::min({st.x[0], st.x[1], st.x[2]}), x1 = std::max({st.x[0], st.x[1], st.x[2]});
-        const double y0 = std::min({st.y[0], st.y[1], st.y[2]}), y1 = std::max({st.y[0], st.y[1], st.y[2]});
-        st.c0 = int(std::max(0.0, std::ceil(x0 - 0.5)));
-        st.c1 = int(std::min(double(width - 1), std::floor(x1 - 0.5)));
-        st.r0 = int(std::max(0.0, std::ceil(y0 - 0.5)));
-        st.r1 = int(std::min(double(height - 1), std::floor(y1 - 0.5)));
-        if (st.c0 <= st.c1 && st.r0 <= st.r1) parts[c].push_back(st);
-      }
+      ScreenPoint sp[4];
+      for (int k = 0; k < n; ++k) sp[k] = to_screen(poly[k]);
+      for (int k = 1; k + 1 < n; ++k) add(&sp[0], &sp[k], &sp[k + 1], std::uint32_t(f));
     }
   });
   std::vector<ScreenTri> tris;

@@ -22,7 +22,8 @@ inline double distance_to_segment(double px, double py, const Segment2& s) {
   const double dx = s.x1 - s.x0, dy = s.y1 - s.y0;
   const double len2 = dx * dx + dy * dy;
   const double t = len2 > 0 ? std::clamp(((px - s.x0) * dx + (py - s.y0) * dy) / len2, 0.0, 1.0) : 0.0;
-  return std::hypot(px - (s.x0 + t * dx), py - (s.y0 + t * dy));
+  const double ex = px - (s.x0 + t * dx), ey = py - (s.y0 + t * dy);
+  return std::sqrt(ex * ex + ey * ey);
 }
 
 /// Calls f(x, y, distance, segment) for every pixel (x, y) whose centre lies within `radius` of a segment.
