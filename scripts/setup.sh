@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Fresh Debian 12 -> working raysift. Usage: scripts/setup.sh demo|test
-#   demo: install missing packages, configure, build, render the bundled engine CT
+#   demo: install missing packages, configure, build, summarise and render the bundled engine CT
 #   test: install missing packages, configure, build, run every test (ctest)
 set -euo pipefail
 mode=${1:-demo}
@@ -28,6 +28,8 @@ cmake --build build -j2
 case "$mode" in
   demo)
     ./build/raysift info datasets/engine_ct.vdb
+    ./build/raysift render --scene datasets/engine_ct_scene.json -o build/demo.png --stats build/demo_stats.json
+    echo "demo: wrote build/demo.png (stats: build/demo_stats.json)"
     ;;
   test)
     ctest --test-dir build --output-on-failure -j2
