@@ -14,7 +14,7 @@
 
 namespace raysift::volume::detail {
 
-inline constexpr int kMcMaxTriangles = 8;  ///< upper bound; the generator checks it
+inline constexpr int kMcMaxTriangles = 5;  ///< the most any case needs (the generator checks it)
 
 inline constexpr std::array<std::uint8_t, 12> kEdgeStart = {0, 2, 4, 6, 0, 1, 4, 5, 0, 1, 2, 3};
 inline constexpr int edge_axis(int edge) { return edge / 4; }
