@@ -77,7 +77,8 @@ FrameRateController::FrameRateController(const FrameRateOptions& options)
   validate(options);
 }
 
-float FrameRateController::update(const FrameTiming& timing, const RayCountCurve& next_frame) {
+float FrameRateController::update(const FrameTiming& timing, const RayCountCurve& next_frame,
+                                  std::size_t already_traced) {
   // Clamp the measurements: a frame can report a trace time of 0 (no rays) or round below it.
   const double cost = std::max(timing.trace_ms, 0.0) / double(std::max<std::size_t>(timing.rays_traced, 1));
   const double overhead = std::max(timing.frame_ms - timing.trace_ms, 0.0);
@@ -86,8 +87,9 @@ float FrameRateController::update(const FrameTiming& timing, const RayCountCurve
   overhead_ms_ = s * overhead + (1 - s) * std::max(overhead_ms_, 0.0);
 
   const float lo = next_frame.alpha00_level0(), hi = next_frame.alpha00_all();
-  const double budget_rays =
-      cost_per_ray_ms_ > 0 ? (target_ms() - overhead_ms_) / cost_per_ray_ms_ : double(next_frame.object_pixels());
+  const double budget_rays = cost_per_ray_ms_ > 0
+                                 ? double(already_traced) + (target_ms() - overhead_ms_) / cost_per_ray_ms_
+                                 : double(next_frame.object_pixels());
   if (budget_rays >= double(next_frame.object_pixels())) {
     alpha00_ = hi;
   } else if (budget_rays <= double(next_frame.level0()) || !(hi > lo)) {

@@ -73,8 +73,10 @@ class FrameRateController {
   float threshold() const { return options_.threshold; }
   /// Updates the estimates with the finished frame and chooses α00 for the next one: the largest α00
   /// whose ray count fits (target - overhead) / cost per ray, clamped to the curve's useful range.
+  /// \param already_traced rays of the next frame that are already known (a still camera reuses them),
+  ///        so only rays beyond these cost time
   /// \return the new α00.
-  float update(const FrameTiming& timing, const RayCountCurve& next_frame);
+  float update(const FrameTiming& timing, const RayCountCurve& next_frame, std::size_t already_traced = 0);
   double cost_per_ray_ms() const { return cost_per_ray_ms_; }
   double overhead_ms() const { return overhead_ms_; }
 
