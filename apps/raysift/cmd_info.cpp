@@ -55,13 +55,14 @@ void print_grid(const volume::GridInfo& g) {
 void print_histogram(const std::string& grid, const volume::Histogram& h) {
   std::printf("  histogram of '%s': %zu bins over [%g, %g], bin width %g\n", grid.c_str(), h.counts.size(), h.min,
               h.max, h.bin_width());
+  if (h.max == h.min && h.counts[0] == 0) return;  // no active voxels: no bins to show
   std::vector<std::size_t> order(h.counts.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   const std::size_t top = std::min<std::size_t>(3, order.size());
   std::partial_sort(order.begin(), order.begin() + std::ptrdiff_t(top), order.end(),
                     [&](std::size_t a, std::size_t b) { return h.counts[a] > h.counts[b]; });
   std::printf("    fullest bins   ");
-  for (std::size_t i = 0; i < top; ++i)
+  for (std::size_t i = 0; i < top && h.counts[order[i]] > 0; ++i)
     std::printf("%s%g (%llu voxels)", i ? ", " : "", h.bin_center(order[i]),
                 static_cast<unsigned long long>(h.counts[order[i]]));
   std::printf("\n");
@@ -89,13 +90,19 @@ RegisterCommand reg("info", "describe the grids of a .vdb file (bbox, voxel size
                         const double read_ms = timer.elapsed_ms();
                         Json stats = {{"command", "info"}, {"file", path}, {"grids", Json::array()}};
                         for (const auto& g : grids) stats["grids"].push_back(grid_json(g));
-                        // The histogram needs a float grid; files with none still get their grid list.
-                        const bool has_float = std::any_of(grids.begin(), grids.end(),
-                                                           [](const auto& g) { return g.type == "float"; });
+                        // The histogram needs a float grid: by default the first one with active voxels (else
+                        // the first one); files with no float grid still get their grid list.
+                        if (grid.empty()) {
+                          for (const auto& g : grids)
+                            if (g.type == "float" && (grid.empty() || g.active_voxels > 0)) {
+                              grid = g.name;
+                              if (g.active_voxels > 0) break;
+                            }
+                        }
                         volume::Histogram hist;
                         std::string hist_grid;
                         timer.reset();
-                        if (has_float || !grid.empty()) {
+                        if (!grid.empty()) {
                           const volume::Volume vol = volume::load_vdb(path, grid, volume::EmptyGrid::Allow);
                           hist = volume::compute_histogram(vol, opt->bins);
                           hist_grid = vol.name();

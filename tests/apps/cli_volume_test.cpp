@@ -100,6 +100,20 @@ TEST(CliVolume, MakeVolumeThenInfoStatsHaveTheDocumentedKeys) {
   EXPECT_EQ(h["max"], g["value_max"]);
 }
 
+TEST(CliVolume, InfoListsEveryGridAndHistogramsTheFirstNonEmptyFloatGrid) {
+  const std::string dir = test::make_temp_dir("cli_mixed");
+  const CliRun r = raysift(
+      dir, "info '" + std::string(RAYSIFT_SOURCE_DIR) + "/tests/volume/data/mixed_grids.vdb' --quiet --stats s.json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(r.out.empty());
+  const Json s = read_json_file(dir + "/s.json");
+  ASSERT_EQ(s["grids"].size(), 4u);
+  EXPECT_EQ(s["grids"][0]["type"], "vec3s");
+  EXPECT_EQ(s["grids"][1]["type"], "int32");
+  EXPECT_EQ(s["histogram"]["grid"], "density");  // 'empty' comes first in the file but has no voxels
+  EXPECT_EQ(s["histogram"]["min"], 0.25);
+}
+
 TEST(CliVolume, EveryGeneratorKindWritesAVolume) {
   const std::string dir = test::make_temp_dir("cli_kinds");
   const std::vector<std::string> kinds = {"ball", "shells", "blobs", "torus", "empty", "single-voxel"};
