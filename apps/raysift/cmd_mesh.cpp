@@ -72,6 +72,23 @@ void validate(const MeshCliOptions& o, CLI::App& sub) {
 
 Json stage_json(const mesh::StageReport& s) { return {{"ms", s.ms}, {"triangles", s.triangles}}; }
 
+/// The effective options as a re-runnable command line (verbose mode).
+std::string echo_command(const MeshCliOptions& o, const std::vector<double>& iso_values, const CommonOptions& common) {
+  std::ostringstream s, iso;
+  iso.precision(17);  // iso-values chosen from the TF must round-trip exactly
+  for (std::size_t i = 0; i < iso_values.size(); ++i) iso << (i ? "," : "") << iso_values[i];
+  s << "raysift mesh " << (o.volume.empty() ? "--scene " + common.scene_path : o.volume);
+  if (!o.grid.empty()) s << " --grid " << o.grid;
+  s << " --iso " << iso.str();
+  s << " --smooth " << o.smooth << " --lambda " << o.lambda << " --mu " << o.mu << (o.cotangent ? " --cotangent" : "");
+  if (o.faces > 0)
+    s << " --faces " << o.faces;
+  else
+    s << " --decimate " << o.decimate;
+  s << " --max-error " << o.max_error << (o.flip ? " --flip" : "") << " --threads " << common.threads << " -o " << o.out;
+  return s.str();
+}
+
 void run(const MeshCliOptions& o, const CommonOptions& common, CLI::App& sub) {
   validate(o, sub);
   Scene scene;
@@ -123,6 +140,7 @@ void run(const MeshCliOptions& o, const CommonOptions& common, CLI::App& sub) {
 
   std::vector<double> iso_values;
   for (const auto& iso : isos) iso_values.push_back(iso.value);
+  if (common.verbose) std::cerr << echo_command(o, iso_values, common) << "\n";
   volume::MarchingCubesOptions mc_options;
   mc_options.flip_orientation = o.flip;
   Timer mc_timer;
