@@ -1,5 +1,8 @@
 #include "mesh/mesh_analysis.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
 #include <algorithm>
 #include <numeric>
 
@@ -47,73 +50,91 @@ struct VertexFaces {
 
 }  // namespace
 
-/// Edge and fan counts into `a` and the kind of every vertex into `kinds`.
+/// Edge counts, summed over the vertices (each edge counted at its lower end point).
+struct EdgeCounts {
+  std::size_t edges = 0, boundary = 0, non_manifold = 0, inconsistent = 0;
+  EdgeCounts& operator+=(const EdgeCounts& o) {
+    edges += o.edges;
+    boundary += o.boundary;
+    non_manifold += o.non_manifold;
+    inconsistent += o.inconsistent;
+    return *this;
+  }
+};
+
+/// Classifies vertex v from its own triangles only (so vertices are independent and run in parallel) and
+/// counts the edges (v, w) with w > v.
+VertexKind scan_vertex(const TriMesh& mesh, const VertexFaces& vf, std::uint32_t v, EdgeCounts& counts,
+                       std::vector<std::pair<std::uint32_t, int>>& sides, std::vector<std::uint32_t>& fan_parent) {
+  const std::uint32_t begin = vf.offsets[v], end = vf.offsets[v + 1];
+  // Sides (w, direction): +1 if a triangle runs v -> w, -1 if it runs w -> v.
+  sides.clear();
+  for (std::uint32_t i = begin; i < end; ++i) {
+    const Tri& t = mesh.triangles[vf.faces[i]];
+    if (has_repeated_index(t)) continue;
+    const int k = t[0] == v ? 0 : (t[1] == v ? 1 : 2);
+    sides.push_back({t[(k + 1) % 3], +1});
+    sides.push_back({t[(k + 2) % 3], -1});
+  }
+  if (sides.empty()) return VertexKind::Isolated;
+  VertexKind kind = VertexKind::Interior;
+  std::sort(sides.begin(), sides.end());
+  for (std::size_t i = 0; i < sides.size();) {
+    std::size_t j = i;
+    int direction_sum = 0;
+    while (j < sides.size() && sides[j].first == sides[i].first) direction_sum += sides[j++].second;
+    const std::size_t faces = j - i;  // triangles on edge (v, w)
+    if (faces == 1) kind = std::max(kind, VertexKind::Boundary);
+    if (faces > 2) kind = VertexKind::NonManifold;
+    if (sides[i].first > v) {
+      ++counts.edges;
+      counts.boundary += faces == 1;
+      counts.non_manifold += faces > 2;
+      counts.inconsistent += faces == 2 && direction_sum != 0;
+    }
+    i = j;
+  }
+  // Fans: incident non-degenerate triangles linked when they share a second vertex.
+  const std::uint32_t n = end - begin;
+  fan_parent.resize(n);
+  std::iota(fan_parent.begin(), fan_parent.end(), 0u);
+  auto find = [&](std::uint32_t x) {
+    while (fan_parent[x] != x) x = fan_parent[x] = fan_parent[fan_parent[x]];
+    return x;
+  };
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const Tri& ti = mesh.triangles[vf.faces[begin + i]];
+    if (has_repeated_index(ti)) continue;
+    for (std::uint32_t j = 0; j < i; ++j) {
+      const Tri& tj = mesh.triangles[vf.faces[begin + j]];
+      if (has_repeated_index(tj)) continue;
+      for (const std::uint32_t w : ti)
+        if (w != v && (w == tj[0] || w == tj[1] || w == tj[2])) fan_parent[find(i)] = find(j);
+    }
+  }
+  std::size_t fans = 0;
+  for (std::uint32_t i = 0; i < n; ++i)
+    if (!has_repeated_index(mesh.triangles[vf.faces[begin + i]]) && find(i) == i) ++fans;
+  return fans > 1 ? VertexKind::NonManifold : kind;
+}
+
+/// Edge counts into `a` and the kind of every vertex into `kinds`; parallel over vertices (integer sums,
+/// so the result does not depend on the thread count).
 void scan_topology(const TriMesh& mesh, const VertexFaces& vf, MeshAnalysis& a, std::vector<VertexKind>& kinds) {
   kinds.assign(mesh.vertex_count(), VertexKind::Isolated);
-  auto mark = [&kinds](std::uint32_t v, VertexKind k) {
-    if (kinds[v] < k) kinds[v] = k;  // NonManifold > Boundary > Interior
-  };
-  // Edges: for every vertex v, the sides (v, w) with w > v among its incident triangles. Each side
-  // records its direction (+1 if the triangle runs v -> w) so orientation consistency can be checked.
-  struct Side {
-    std::uint32_t other;
-    int direction;
-  };
-  std::vector<Side> sides;
-  std::vector<std::uint32_t> fan_parent;
-  for (std::uint32_t v = 0; v < a.vertices; ++v) {
-    sides.clear();
-    const std::uint32_t begin = vf.offsets[v], end = vf.offsets[v + 1];
-    for (std::uint32_t i = begin; i < end; ++i) {
-      const Tri& t = mesh.triangles[vf.faces[i]];
-      if (has_repeated_index(t)) continue;
-      const int k = t[0] == v ? 0 : (t[1] == v ? 1 : 2);
-      const std::uint32_t next = t[(k + 1) % 3], prev = t[(k + 2) % 3];
-      if (next > v) sides.push_back({next, +1});
-      if (prev > v) sides.push_back({prev, -1});
-    }
-    std::sort(sides.begin(), sides.end(), [](const Side& x, const Side& y) { return x.other < y.other; });
-    for (std::size_t i = 0; i < sides.size();) {
-      std::size_t j = i;
-      int direction_sum = 0;
-      while (j < sides.size() && sides[j].other == sides[i].other) direction_sum += sides[j++].direction;
-      const std::size_t count = j - i;
-      ++a.edges;
-      const VertexKind kind = count == 1 ? VertexKind::Boundary : (count > 2 ? VertexKind::NonManifold : VertexKind::Interior);
-      mark(v, kind);
-      mark(sides[i].other, kind);
-      if (count == 1) ++a.boundary_edges;
-      if (count > 2) ++a.non_manifold_edges;
-      if (count == 2 && direction_sum != 0) ++a.inconsistent_edges;
-      i = j;
-    }
-
-    // Fans around v: incident non-degenerate triangles are linked when they share a second vertex.
-    const std::uint32_t n = end - begin;
-    fan_parent.resize(n);
-    std::iota(fan_parent.begin(), fan_parent.end(), 0u);
-    auto find = [&](std::uint32_t x) {
-      while (fan_parent[x] != x) x = fan_parent[x] = fan_parent[fan_parent[x]];
-      return x;
-    };
-    std::size_t valid = 0;
-    for (std::uint32_t i = 0; i < n; ++i) {
-      const Tri& ti = mesh.triangles[vf.faces[begin + i]];
-      if (has_repeated_index(ti)) continue;
-      ++valid;
-      for (std::uint32_t j = 0; j < i; ++j) {
-        const Tri& tj = mesh.triangles[vf.faces[begin + j]];
-        if (has_repeated_index(tj)) continue;
-        for (const std::uint32_t w : ti)
-          if (w != v && (w == tj[0] || w == tj[1] || w == tj[2])) fan_parent[find(i)] = find(j);
-      }
-    }
-    std::size_t fans = 0;
-    for (std::uint32_t i = 0; i < n; ++i)
-      if (!has_repeated_index(mesh.triangles[vf.faces[begin + i]]) && find(i) == i) ++fans;
-    if (valid > 0 && fans > 1) mark(v, VertexKind::NonManifold);
-  }
-  // Counted after the loop: a vertex also becomes non-manifold through an edge found at a lower vertex.
+  const EdgeCounts counts = tbb::parallel_reduce(
+      tbb::blocked_range<std::uint32_t>(0, std::uint32_t(mesh.vertex_count()), 1024), EdgeCounts{},
+      [&](const tbb::blocked_range<std::uint32_t>& r, EdgeCounts partial) {
+        std::vector<std::pair<std::uint32_t, int>> sides;
+        std::vector<std::uint32_t> fan_parent;
+        for (std::uint32_t v = r.begin(); v < r.end(); ++v) kinds[v] = scan_vertex(mesh, vf, v, partial, sides, fan_parent);
+        return partial;
+      },
+      [](EdgeCounts x, const EdgeCounts& y) { return x += y; });
+  a.edges = counts.edges;
+  a.boundary_edges = counts.boundary;
+  a.non_manifold_edges = counts.non_manifold;
+  a.inconsistent_edges = counts.inconsistent;
   a.non_manifold_vertices = std::size_t(std::count(kinds.begin(), kinds.end(), VertexKind::NonManifold));
 }
 
