@@ -16,7 +16,7 @@ namespace {
 constexpr int kBandRows = 16;
 
 struct ScreenTri {
-  double x[3], y[3], inv_z[3];
+  float x[3], y[3], inv_z[3];  // float keeps the array small; set-up and coverage run in double
   int r0, r1, c0, c1;  // rows and columns whose pixel centres the triangle's bounds span (inclusive)
   std::uint32_t face;
 };
@@ -95,9 +95,9 @@ DepthBuffer rasterize_depth(const mesh::TriMesh& mesh, const Camera& camera, con
       st.face = face;
       const ScreenPoint* corner[3] = {p0, p1, p2};
       for (int j = 0; j < 3; ++j) {
-        st.x[j] = corner[j]->x;
-        st.y[j] = corner[j]->y;
-        st.inv_z[j] = corner[j]->inv_z;
+        st.x[j] = float(corner[j]->x);
+        st.y[j] = float(corner[j]->y);
+        st.inv_z[j] = float(corner[j]->inv_z);
       }
       // Pixel centres (i + 0.5) inside the bounds; triangles that cover none are dropped here.
       const double x0 = std::min({st.x[0], st.x[1], st.x[2]}), x1 = std::max({st.x[0], st.x[1], st.x[2]});
@@ -131,35 +131,38 @@ DepthBuffer rasterize_depth(const mesh::TriMesh& mesh, const Camera& camera, con
       for (int k = 1; k + 1 < n; ++k) add(&sp[0], &sp[k], &sp[k + 1], std::uint32_t(f));
     }
   });
-  std::vector<ScreenTri> tris;
-  for (auto& p : parts) tris.insert(tris.end(), p.begin(), p.end());
+  // Triangles in face order without copying the per-chunk arrays.
+  std::vector<const ScreenTri*> tris;
+  for (const auto& p : parts)
+    for (const ScreenTri& st : p) tris.push_back(&st);
 
   // Bin the triangles into bands of rows, in triangle order.
   const int bands = (height + kBandRows - 1) / kBandRows;
   std::vector<std::uint32_t> band_offset(std::size_t(bands) + 1, 0);
-  for (const ScreenTri& st : tris)
-    for (int b = st.r0 / kBandRows; b <= st.r1 / kBandRows; ++b) ++band_offset[std::size_t(b) + 1];
+  for (const ScreenTri* st : tris)
+    for (int b = st->r0 / kBandRows; b <= st->r1 / kBandRows; ++b) ++band_offset[std::size_t(b) + 1];
   for (int b = 0; b < bands; ++b) band_offset[std::size_t(b) + 1] += band_offset[std::size_t(b)];
   std::vector<std::uint32_t> band_tris(band_offset.back());
   std::vector<std::uint32_t> fill(band_offset.begin(), band_offset.end() - 1);
   for (std::size_t i = 0; i < tris.size(); ++i)
-    for (int b = tris[i].r0 / kBandRows; b <= tris[i].r1 / kBandRows; ++b)
+    for (int b = tris[i]->r0 / kBandRows; b <= tris[i]->r1 / kBandRows; ++b)
       band_tris[fill[std::size_t(b)]++] = std::uint32_t(i);
 
   for_chunks(std::size_t(bands), 1, options.threaded, [&](std::size_t band, std::size_t, std::size_t) {
     const int band_r0 = int(band) * kBandRows, band_r1 = std::min(height - 1, band_r0 + kBandRows - 1);
     for (std::uint32_t k = band_offset[band]; k < band_offset[band + 1]; ++k) {
-      const ScreenTri& st = tris[band_tris[k]];
-      const double area = (st.x[1] - st.x[0]) * (st.y[2] - st.y[0]) - (st.x[2] - st.x[0]) * (st.y[1] - st.y[0]);
+      const ScreenTri& st = *tris[band_tris[k]];
+      const double x[3] = {st.x[0], st.x[1], st.x[2]}, y[3] = {st.y[0], st.y[1], st.y[2]};
+      const double area = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
       if (!(std::abs(area) > 1e-12)) continue;
       // Edge function of the edge opposite corner j, scaled by 1/area so that it is the barycentric
       // coordinate: e_j(x, y) = a_j·x + b_j·y + c_j.
       double ea[3], eb[3], ec[3];
       for (int j = 0; j < 3; ++j) {
         const int a = (j + 1) % 3, c = (j + 2) % 3;
-        ea[j] = -(st.y[c] - st.y[a]) / area;
-        eb[j] = (st.x[c] - st.x[a]) / area;
-        ec[j] = -(ea[j] * st.x[a] + eb[j] * st.y[a]);
+        ea[j] = -(y[c] - y[a]) / area;
+        eb[j] = (x[c] - x[a]) / area;
+        ec[j] = -(ea[j] * x[a] + eb[j] * y[a]);
       }
       for (int r = std::max(st.r0, band_r0); r <= std::min(st.r1, band_r1); ++r) {
         const double py = r + 0.5;
@@ -169,7 +172,7 @@ DepthBuffer rasterize_depth(const mesh::TriMesh& mesh, const Camera& camera, con
           const double b1 = ea[1] * px + eb[1] * py + ec[1];
           const double b2 = ea[2] * px + eb[2] * py + ec[2];
           if (b0 < 0 || b1 < 0 || b2 < 0) continue;
-          const float z = float(1.0 / (b0 * st.inv_z[0] + b1 * st.inv_z[1] + b2 * st.inv_z[2]));
+          const float z = float(1.0 / (b0 * double(st.inv_z[0]) + b1 * double(st.inv_z[1]) + b2 * double(st.inv_z[2])));
           float& cur = out.depth(col, r);
           std::uint32_t& cur_face = out.face(col, r);
           if (z < cur || (z == cur && st.face < cur_face)) {
