@@ -87,11 +87,17 @@ Vec3f parse_background(const std::string& text) {
   return {v[0], v[1], v[2]};
 }
 
+std::string num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
 void validate(const RenderCliOptions& o) {
   if (!modes().count(o.mode)) bad_flag("--mode", mode_names(), o.mode);
-  if (!(o.step > 0 && o.step <= 64)) bad_flag("--step", "in (0, 64] voxels", std::to_string(o.step));
+  if (!(o.step > 0 && o.step <= 64)) bad_flag("--step", "in (0, 64] voxels", num(o.step));
   if (!(o.early_termination > 0 && o.early_termination <= 1))
-    bad_flag("--early-termination", "in (0, 1]", std::to_string(o.early_termination));
+    bad_flag("--early-termination", "in (0, 1]", num(o.early_termination));
   if (o.width != -1 && (o.width < 1 || o.width > kMaxImageSide))
     bad_flag("--width", "1.." + std::to_string(kMaxImageSide), std::to_string(o.width));
   if (o.height != -1 && (o.height < 1 || o.height > kMaxImageSide))
@@ -129,6 +135,7 @@ RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common
   }
 
   std::optional<CameraSpec> camera = scene.camera;
+  const std::string camera_source = !o.camera.empty() ? o.camera : scene.source;
   if (!o.camera.empty()) camera = camera_spec_from_json(read_json_file(o.camera), o.camera);
   const int width = o.width != -1 ? o.width : camera ? camera->width : CameraSpec{}.width;
   const int height = o.height != -1 ? o.height : camera ? camera->height : CameraSpec{}.height;
@@ -136,6 +143,11 @@ RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common
     in.camera = *camera;
     in.camera.width = width;
     in.camera.height = height;
+    try {
+      static_cast<void>(Camera{in.camera});
+    } catch (const InvalidInput& e) {
+      throw InvalidInput(file_message(camera_source, e.what()));
+    }
   } else {
     in.camera = volume::fit_camera(in.volume, width, height);
   }

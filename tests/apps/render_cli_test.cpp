@@ -1,0 +1,139 @@
+// CLI tests for `raysift render`: stats keys, the scene file with flag overrides, pixel-exact agreement
+// of --pixel with the image, and bad input (exit 2 for usage, 1 for bad files, never a partial output).
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "core/image.h"
+#include "core/json_io.h"
+#include "tests/support/test_support.h"
+
+namespace raysift {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int code = -1;
+  std::string err;
+};
+
+CliRun raysift(const std::string& dir, const std::string& args) {
+  const std::string cmd = "cd '" + dir + "' && '" + RAYSIFT_EXE + "' " + args + " >stdout.txt 2>stderr.txt";
+  const int status = std::system(cmd.c_str());
+  CliRun r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream in(dir + "/stderr.txt");
+  std::stringstream s;
+  s << in.rdbuf();
+  r.err = s.str();
+  return r;
+}
+
+const std::string kDatasets = std::string(RAYSIFT_SOURCE_DIR) + "/datasets";
+
+/// A 12-voxel ball (make-volume) and a step TF at its surface value 0.5 with opacity 0.3 per voxel.
+std::string make_ball_dir(const std::string& tag) {
+  const std::string dir = test::make_temp_dir(tag);
+  const CliRun make = raysift(dir, "make-volume ball --dims 32,32,32 --radius 12 --quiet -o ball.vdb");
+  EXPECT_EQ(make.code, 0) << make.err;
+  write_json_file(dir + "/tf.json", Json::parse(R"({"points": [[0,1,0.5,0,0],[0.5,1,0.5,0,0],[0.51,1,0.5,0,0.3],[1,1,0.5,0,0.3]]})"));
+  return dir;
+}
+
+TEST(RenderCli, WritesImageAndDocumentedStats) {
+  const std::string dir = make_ball_dir("render_stats");
+  const CliRun r = raysift(dir, "render ball.vdb --tf tf.json --width 40 --height 30 -o out.exr --stats s.json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Json s = read_json_file(dir + "/s.json");
+  EXPECT_EQ(s["mode"], "full");
+  EXPECT_EQ(s["width"], 40);
+  EXPECT_EQ(s["height"], 30);
+  EXPECT_EQ(s["rays_traced"], 1200);
+  EXPECT_GT(s["samples"].get<double>(), 0);
+  for (const char* key : {"setup", "trace", "total"}) EXPECT_TRUE(s["times_ms"].contains(key)) << key;
+  const ImageRGBA img = read_image_rgba(dir + "/out.exr");
+  ASSERT_EQ(img.width, 40);
+  // The default camera looks at the ball's centre: the centre pixel is orange over black, the corner
+  // pixel is exactly the background.
+  EXPECT_GT(img(20, 15).r, 0.5f);
+  EXPECT_GT(img(20, 15).a, 0.9f);
+  EXPECT_EQ(img(0, 0), (Rgba{0, 0, 0, 0}));
+}
+
+TEST(RenderCli, PixelDebugMatchesImage) {
+  const std::string dir = make_ball_dir("render_pixel");
+  ASSERT_EQ(raysift(dir, "render ball.vdb --tf tf.json --width 16 --height 16 --background 0,0,1 -o out.exr").code, 0);
+  const CliRun p = raysift(dir, "render ball.vdb --tf tf.json --width 16 --height 16 --background 0,0,1 --pixel 8,7 -o x.exr");
+  ASSERT_EQ(p.code, 0) << p.err;
+  EXPECT_FALSE(fs::exists(dir + "/x.exr"));
+  std::ifstream out(dir + "/stdout.txt");
+  std::string word;
+  float v[7];
+  out >> word >> word >> word;  // "pixel 8,7: premultiplied"
+  for (int i = 0; i < 4; ++i) out >> v[i];
+  out >> word;  // "composited"
+  for (int i = 4; i < 7; ++i) out >> v[i];
+  const ImageRGBA img = read_image_rgba(dir + "/out.exr");
+  EXPECT_NEAR(img(8, 7).r, v[4], 1e-5f);  // printed with 6 significant digits
+  EXPECT_NEAR(img(8, 7).b, v[6], 1e-5f);
+  EXPECT_NEAR(img(8, 7).a, v[3], 1e-5f);
+}
+
+TEST(RenderCli, SceneProvidesVolumeTfAndCameraFlagsOverride) {
+  const std::string dir = test::make_temp_dir("render_scene");
+  const CliRun r = raysift(dir, "render --scene " + kDatasets + "/engine_ct_scene.json --width 24 --height 16 --step 2 "
+                                "-o out.png --stats s.json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Json s = read_json_file(dir + "/s.json");
+  EXPECT_EQ(s["width"], 24);
+  EXPECT_EQ(s["height"], 16);
+  EXPECT_EQ(s["step_voxels"], 2.0);
+  const ImageRGBA img = read_image_rgba(dir + "/out.png");
+  EXPECT_EQ(img.width, 24);
+  EXPECT_FLOAT_EQ(img(0, 0).a, 1.0f);  // PNG is written opaque
+}
+
+TEST(RenderCli, BadInputFailsWithoutOutput) {
+  const std::string dir = make_ball_dir("render_bad");
+  write_json_file(dir + "/cam_flat.json", Json::parse(R"({"eye": [1, 2, 3], "target": [1, 2, 3]})"));
+  const struct {
+    std::string args;
+    int code;
+    const char* message;
+  } cases[] = {
+      {"--tf tf.json --step 0", 2, "--step"},
+      {"--tf tf.json --width 0", 2, "--width"},
+      {"--tf tf.json --height 16385", 2, "--height"},
+      {"--tf tf.json --early-termination 0", 2, "--early-termination"},
+      {"--tf tf.json --background 1,2", 2, "--background"},
+      {"--tf tf.json --mode fancy", 2, "--mode"},
+      {"--tf tf.json --camera cam_flat.json", 1, "cam_flat.json"},
+      {"--tf missing.json", 1, "missing.json"},
+  };
+  for (const auto& c : cases) {
+    const CliRun r = raysift(dir, "render ball.vdb --width 8 --height 8 -o out.exr " + c.args);
+    EXPECT_EQ(r.code, c.code) << c.args << ": " << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << ": " << r.err;
+    EXPECT_FALSE(fs::exists(dir + "/out.exr")) << c.args;
+  }
+  const CliRun ext = raysift(dir, "render ball.vdb --tf tf.json -o out.jpg");
+  EXPECT_EQ(ext.code, 2);
+  EXPECT_FALSE(fs::exists(dir + "/out.jpg"));
+}
+
+TEST(RenderCli, TfOutsideDataRangeWarnsAndRendersBackground) {
+  const std::string dir = make_ball_dir("render_range");
+  write_json_file(dir + "/far.json", Json::parse(R"({"points": [[100,1,1,1,0],[200,1,1,1,1]]})"));
+  const CliRun r = raysift(dir, "render ball.vdb --tf far.json --width 8 --height 8 --background 0.5,0.5,0.5 -o out.exr");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("does not overlap"), std::string::npos) << r.err;
+  const ImageRGBA img = read_image_rgba(dir + "/out.exr");
+  for (const Rgba& p : img.pixels) EXPECT_EQ(p, (Rgba{0.5f, 0.5f, 0.5f, 0.0f}));
+}
+
+}  // namespace
+}  // namespace raysift
