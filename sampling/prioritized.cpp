@@ -28,6 +28,19 @@ void mark(Span<const std::uint32_t> pixels, ImageMask& mask) {
   for (std::uint32_t p : pixels) mask.pixels[p] = 1;
 }
 
+// The selected pixels in 32x32-tile order: neighbouring rays share volume blocks and cache lines, which
+// the priority order (scattered by design) does not. Used whenever the whole set is traced anyway.
+std::vector<std::uint32_t> in_tile_order(const ImageMask& selected) {
+  constexpr int kTile = 32;
+  std::vector<std::uint32_t> out;
+  for (int ty = 0; ty < selected.height; ty += kTile)
+    for (int tx = 0; tx < selected.width; tx += kTile)
+      for (int y = ty; y < std::min(ty + kTile, selected.height); ++y)
+        for (int x = tx; x < std::min(tx + kTile, selected.width); ++x)
+          if (selected(x, y)) out.push_back(std::uint32_t(y) * std::uint32_t(selected.width) + std::uint32_t(x));
+  return out;
+}
+
 std::size_t ray_target(const SamplingOptions& options, std::size_t object, std::size_t level0) {
   const auto wanted = std::size_t(std::llround(options.ray_fraction * double(object)));
   return std::min(object, std::max(level0, wanted));
@@ -99,10 +112,9 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
   const std::size_t target = ray_target(options, counts.object, counts.level0);
 
   if (options.mode == SamplingMode::Full) {
-    std::vector<std::uint32_t> all;
-    all.reserve(counts.object);
-    for (std::size_t i = 0; i < importance.size(); ++i)
-      if (importance.pixels[i] >= 0) all.push_back(std::uint32_t(i));
+    ImageMask object(w, h, 0);
+    for (std::size_t i = 0; i < importance.size(); ++i) object.pixels[i] = importance.pixels[i] >= 0 ? 1 : 0;
+    const std::vector<std::uint32_t> all = in_tile_order(object);
     frame.priorities_ms = stage.elapsed_ms();
     stage.reset();
     trace_all(all, trace, frame.image);
@@ -114,10 +126,10 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
 
   if (options.mode == SamplingMode::Subsample) {
     const SampleGrid grid = subsample_grid_for(importance, target, nullptr);
-    std::vector<std::uint32_t> rays;
+    ImageMask on_grid(w, h, 0);
     for (int y : grid.ys)
-      for (int x : grid.xs)
-        if (importance(x, y) >= 0) rays.push_back(std::uint32_t(y) * std::uint32_t(w) + std::uint32_t(x));
+      for (int x : grid.xs) on_grid(x, y) = importance(x, y) >= 0 ? 1 : 0;
+    const std::vector<std::uint32_t> rays = in_tile_order(on_grid);
     frame.priorities_ms = stage.elapsed_ms();
     stage.reset();
     trace_all(rays, trace, frame.image);
@@ -146,15 +158,17 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
                                          trace, frame.image, clock, deadline);
     frame.rays_traced = queue.level0_count + more;
     frame.trace_ms = stage.elapsed_ms();
+    mark(Span<const std::uint32_t>(queue.pixels.data(), frame.rays_traced), frame.traced);
   } else {
     queue = select_top_rays(importance, pattern, options.mapping, target, options.seed, options.threshold);
+    mark(queue.pixels, frame.traced);
+    const std::vector<std::uint32_t> rays = in_tile_order(frame.traced);
     frame.priorities_ms = stage.elapsed_ms();
     stage.reset();
-    trace_all(queue.pixels, trace, frame.image);
-    frame.rays_traced = queue.pixels.size();
+    trace_all(rays, trace, frame.image);
+    frame.rays_traced = rays.size();
     frame.trace_ms = stage.elapsed_ms();
   }
-  mark(Span<const std::uint32_t>(queue.pixels.data(), frame.rays_traced), frame.traced);
 
   stage.reset();
   if (frame.rays_traced < counts.object) {

@@ -1,0 +1,143 @@
+#include "sampling/volume_sampling.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+
+#include "core/errors.h"
+#include "core/timer.h"
+#include "mesh/mesh_analysis.h"
+#include "mesh/mesh_prep.h"
+#include "volume/iso_values.h"
+#include "volume/marching_cubes.h"
+
+namespace raysift::sampling {
+
+namespace {
+
+// Marching cubes can join sheets at a vertex (two fans) which OpenMesh's decimater cannot represent;
+// dropping the few triangles around such vertices leaves tiny holes that do not change the lines.
+mesh::TriMesh drop_non_manifold_fans(const mesh::TriMesh& surface, std::size_t& dropped) {
+  const std::vector<mesh::VertexKind> kinds = mesh::classify_vertices(surface);
+  mesh::TriMesh out;
+  out.positions = surface.positions;
+  for (const auto& t : surface.triangles) {
+    const bool bad = kinds[t[0]] == mesh::VertexKind::NonManifold || kinds[t[1]] == mesh::VertexKind::NonManifold ||
+                     kinds[t[2]] == mesh::VertexKind::NonManifold;
+    if (bad) {
+      ++dropped;
+    } else {
+      out.triangles.push_back(t);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+FeatureGeometry build_feature_geometry(const volume::Volume& volume, const volume::TransferFunction& tf,
+                                       const FeatureGeometryOptions& options) {
+  const Timer timer;
+  FeatureGeometry geometry;
+  geometry.iso_values = options.iso_values;
+  if (geometry.iso_values.empty()) {
+    volume::IsoValueOptions iso_options;
+    iso_options.max_surfaces = options.max_surfaces;
+    for (const volume::IsoValue& v : volume::select_iso_values(volume, tf, iso_options))
+      geometry.iso_values.push_back(v.value);
+  }
+  // Taubin -> decimation -> Taubin per surface (RP paper section 7.2), then one merged mesh.
+  mesh::MeshPrepOptions prep;
+  prep.smooth_before.iterations = prep.smooth_after.iterations = options.smooth_iterations;
+  prep.decimation.ratio = options.decimate_ratio;
+  for (const mesh::TriMesh& raw : volume::extract_isosurfaces(volume, geometry.iso_values)) {
+    if (raw.triangles.empty()) continue;
+    mesh::TriMesh surface;
+    try {
+      surface = mesh::prepare_mesh(drop_non_manifold_fans(raw, geometry.dropped_triangles), prep).mesh;
+    } catch (const InvalidInput&) {
+      // The decimater still refused the surface: keep it smoothed at full size (slower lines, same features).
+      mesh::MeshPrepOptions smooth_only = prep;
+      smooth_only.decimation.ratio = 1.0;
+      surface = mesh::prepare_mesh(raw, smooth_only).mesh;
+      ++geometry.undecimated_surfaces;
+    }
+    const auto base = std::uint32_t(geometry.mesh.positions.size());
+    geometry.mesh.positions.insert(geometry.mesh.positions.end(), surface.positions.begin(), surface.positions.end());
+    for (const auto& t : surface.triangles) geometry.mesh.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+  }
+  if (geometry.mesh.triangles.empty())
+    throw InvalidInput("the iso-values chosen for the feature lines give no surface; pass iso-values inside the "
+                       "data range");
+  geometry.curvature = mesh::compute_curvature(geometry.mesh);
+  geometry.build_ms = timer.elapsed_ms();
+  return geometry;
+}
+
+features::LineClassSet parse_feature_list(const std::string& list) {
+  if (list == "none") return {};
+  return features::parse_line_classes(list);
+}
+
+ImageF frame_importance(const volume::RayCaster& caster, const FeatureGeometry* geometry,
+                        const FeatureOptions& options) {
+  const int w = caster.width(), h = caster.height();
+  ImageF importance(w, h, 0.0f);
+  features::ImportanceBuffer buffer;
+  const bool has_lines = geometry != nullptr && !options.classes.is_empty();
+  if (has_lines) {
+    features::LineOptions lines = options.lines;
+    lines.classes = options.classes;
+    // No background geometry: the caster's exact test below decides background.
+    buffer = features::compute_importance(geometry->mesh, geometry->curvature, caster.camera(), lines,
+                                          features::BackgroundGeometry{}, options.importance);
+  }
+  tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y < rows.end(); ++y)
+      for (int x = 0; x < w; ++x) {
+        if (caster.pixel_is_background(x, y)) {
+          importance(x, y) = -1.0f;
+        } else if (has_lines) {
+          importance(x, y) = std::min(1.0f, std::max(0.0f, features::sample_importance(buffer, x, y)));
+        }
+      }
+  });
+  return importance;
+}
+
+TraceBatch caster_trace_batch(const volume::RayCaster& caster) {
+  return [&caster](Span<const std::uint32_t> pixels, Span<Rgba> out) {
+    std::array<volume::RaySample, kRayGroup> samples;
+    for (std::size_t first = 0; first < pixels.size(); first += kRayGroup) {
+      const std::size_t n = std::min(kRayGroup, pixels.size() - first);
+      caster.trace_pixels(Span<const std::uint32_t>(pixels.data() + first, n),
+                          Span<volume::RaySample>(samples.data(), n));
+      for (std::size_t i = 0; i < n; ++i) out[first + i] = samples[i].color;
+    }
+  };
+}
+
+ImageRGBA composite_frame(const ImageRGBA& premultiplied, const Vec3f& background) {
+  ImageRGBA out(premultiplied.width, premultiplied.height);
+  for (std::size_t i = 0; i < out.size(); ++i)
+    out.pixels[i] = volume::composite_over_background(premultiplied.pixels[i], background);
+  return out;
+}
+
+VolumeFrame render_volume_frame(const volume::RayCaster& caster, const FeatureGeometry* geometry,
+                                const FeatureOptions& features, const SamplingOptions& sampling) {
+  validate(sampling);
+  const Timer total;
+  VolumeFrame frame;
+  const ImageF importance = frame_importance(caster, geometry, features);
+  frame.importance_ms = total.elapsed_ms();
+  frame.sampled = render_sampled(importance, caster_trace_batch(caster), sampling, frame.importance_ms);
+  frame.image = composite_frame(frame.sampled.image, caster.options().background);
+  frame.sampled.image = ImageRGBA();
+  frame.total_ms = total.elapsed_ms();
+  return frame;
+}
+
+}  // namespace raysift::sampling
