@@ -1,6 +1,7 @@
 #include "volume/import.h"
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <cstring>
 #include <fstream>
@@ -85,6 +86,23 @@ TEST(ImportRaw, SparseImportKeepsExactlyTheNonBackgroundVoxels) {
   for (std::size_t i = 0; i < bytes.size(); ++i) {
     const Vec3i ijk(int(i % 16), int(i / 16 % 12), int(i / 192));
     ASSERT_EQ(v.value_at(ijk), float(static_cast<unsigned char>(bytes[i]))) << i;
+  }
+}
+
+TEST(ImportRaw, IdenticalForOneAndTwoThreads) {
+  const std::string path = test::make_temp_dir("raw_threads") + "/v.raw";
+  std::string bytes(40 * 30 * 20, '\0');
+  for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = char((i * 2654435761u >> 13) % 7 == 0 ? 1 + i % 250 : 0);
+  write_file(path, bytes);
+  auto run = [&](int threads) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+    return import_raw(path, {{40, 30, 20}, ScalarType::U8, Endian::Little});
+  };
+  const Volume a = run(1), b = run(2);
+  ASSERT_EQ(a.active_voxel_count(), b.active_voxel_count());
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    const Vec3i ijk(int(i % 40), int(i / 40 % 30), int(i / 1200));
+    ASSERT_EQ(a.value_at(ijk), b.value_at(ijk)) << i;
   }
 }
 

@@ -129,6 +129,22 @@ TEST(VdbIo, InspectListsEveryGridWithTypeAndStats) {
   EXPECT_EQ(d.bbox_max, Vec3d(2.5, 3.0, 3.5));  // (5,6,7) * 0.5
 }
 
+TEST(VdbIo, BundledDatasetsMatchTheirReadme) {
+  // datasets/README.md states these numbers; the files are imported from the shared raw volumes.
+  const std::string dir = std::string(RAYSIFT_SOURCE_DIR) + "/datasets/";
+  const std::vector<GridInfo> engine = inspect_vdb(dir + "engine_ct.vdb");
+  ASSERT_EQ(engine.size(), 1u);
+  EXPECT_EQ(engine[0].active_voxels, 5198360u);
+  EXPECT_EQ(engine[0].value_min, 1.0);
+  EXPECT_EQ(engine[0].value_max, 255.0);
+  EXPECT_EQ(engine[0].bbox_max, Vec3d(255, 255, 127));
+  const std::vector<GridInfo> head = inspect_vdb(dir + "mri_head.vdb");
+  ASSERT_EQ(head.size(), 1u);
+  EXPECT_EQ(head[0].active_voxels, 1193707u);
+  EXPECT_EQ(head[0].value_max, 202.0);
+  EXPECT_EQ(head[0].bbox_max, Vec3d(127, 127, 83));
+}
+
 TEST(VdbIo, SaveIsAtomicOnFailure) {
   const std::string dir = test::make_temp_dir("vdb_save_fail");
   EXPECT_THROW(save_vdb(dir + "/no_such_folder/out.vdb", small_ball()), IoError);
