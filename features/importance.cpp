@@ -126,7 +126,9 @@ ImportanceBuffer rasterize(const FeatureLines& visible, const Camera& frame, con
     detail::for_each_pixel_near_segments(w, h, level_segs, kLineCorePx, o.threaded,
                                          [&](int x, int y, double, const detail::Segment2&) { seeds(x, y) = 1; });
     const ImageF d2 = detail::squared_distance_transform(seeds, o.threaded);
+    const float reach2 = float((0.5 + falloff) * (0.5 + falloff));
     for_pixels(w, h, o.threaded, [&](int x, int y) {
+      if (d2(x, y) >= reach2) return;  // beyond the fall-off: contributes 0
       const double u = std::clamp((std::sqrt(double(d2(x, y))) - 0.5) / falloff, 0.0, 1.0);
       float& cur = out.values(x, y);
       cur = std::max(cur, float(level * (1.0 - u * u * (3.0 - 2.0 * u))));
@@ -137,11 +139,13 @@ ImportanceBuffer rasterize(const FeatureLines& visible, const Camera& frame, con
     const Image<std::uint8_t> hit = coverage(cam, bg, mesh_frame_depth, o.threaded);
     // Conservative: background only if no neighbouring buffer pixel sees the geometry, so that upsampling
     // to the frame never skips a frame pixel whose ray hits it.
+    Image<std::uint8_t> row_hit(w, h, 0);  // separable 3x3 dilation: rows, then columns
     for_pixels(w, h, o.threaded, [&](int x, int y) {
-      for (int yy = std::max(0, y - 1); yy <= std::min(h - 1, y + 1); ++yy)
-        for (int xx = std::max(0, x - 1); xx <= std::min(w - 1, x + 1); ++xx)
-          if (hit(xx, yy)) return;
-      out.values(x, y) = o.background_value;
+      row_hit(x, y) = hit(x, y) | (x > 0 ? hit(x - 1, y) : 0) | (x + 1 < w ? hit(x + 1, y) : 0);
+    });
+    for_pixels(w, h, o.threaded, [&](int x, int y) {
+      if (!(row_hit(x, y) | (y > 0 ? row_hit(x, y - 1) : 0) | (y + 1 < h ? row_hit(x, y + 1) : 0)))
+        out.values(x, y) = o.background_value;
     });
   }
   return out;
