@@ -1,0 +1,138 @@
+// Prioritized rendering with the real ray caster and line importance on small analytic volumes.
+#include "sampling/volume_sampling.h"
+
+#include <gtest/gtest.h>
+#include <tbb/task_arena.h>
+
+#include <cmath>
+
+#include "volume/generate.h"
+
+namespace raysift::sampling {
+namespace {
+
+struct Fixture {
+  volume::Volume volume;
+  volume::TransferFunction tf{{{0.0, 0, 0, 0, 0}, {0.3, 0.9, 0.6, 0.3, 0.0}, {0.6, 0.8, 0.8, 0.9, 0.6}, {1.0, 1, 1, 1, 0.9}}};
+  volume::RenderOptions options;
+  CameraSpec camera;
+  Fixture() {
+    volume::TorusOptions torus;
+    torus.grid.dims = {48, 48, 48};
+    torus.major_radius_voxels = 14;
+    torus.minor_radius_voxels = 5;
+    volume = volume::make_torus(torus);
+    camera = volume::fit_camera(volume, 72, 56);
+    camera.eye = {camera.eye.x + 20, camera.eye.y + 25, camera.eye.z};  // oblique: contours inside the frame
+    options.shading = volume::Shading::Phong;
+    options.background = {0.2f, 0.3f, 0.4f};
+  }
+};
+
+const Fixture& fixture() {
+  static const Fixture f;
+  return f;
+}
+
+const FeatureGeometry& torus_geometry() {
+  static const FeatureGeometry g = [] {
+    FeatureGeometryOptions o;
+    o.iso_values = {0.5};
+    o.decimate_ratio = 0.5;
+    return build_feature_geometry(fixture().volume, fixture().tf, o);
+  }();
+  return g;
+}
+
+FeatureOptions contour_features() {
+  FeatureOptions f;
+  f.classes = parse_feature_list("contours,silhouettes");
+  return f;
+}
+
+SamplingOptions sampling(SamplingMode mode, double fraction) {
+  SamplingOptions s;
+  s.mode = mode;
+  s.ray_fraction = fraction;
+  return s;
+}
+
+TEST(VolumeSampling, FractionOneReproducesRenderFullBitExactly) {
+  const Fixture& f = fixture();
+  const volume::RayCaster caster(f.volume, f.tf, f.camera, f.options);
+  const ImageRGBA full = volume::render_full(caster).image;
+  struct Case {
+    SamplingMode mode;
+    bool features;
+  };
+  for (const Case c : {Case{SamplingMode::Full, false}, Case{SamplingMode::Prioritized, true},
+                       Case{SamplingMode::Prioritized, false}, Case{SamplingMode::Subsample, false}}) {
+    const VolumeFrame frame = render_volume_frame(caster, c.features ? &torus_geometry() : nullptr,
+                                                  c.features ? contour_features() : FeatureOptions{},
+                                                  sampling(c.mode, 1.0));
+    for (std::size_t i = 0; i < full.size(); ++i)
+      ASSERT_EQ(frame.image.pixels[i], full.pixels[i]) << sampling_mode_name(c.mode) << " pixel " << i;
+  }
+  // Progressive refinement converges to the same image.
+  const ImageF importance = frame_importance(caster, &torus_geometry(), contour_features());
+  ProgressiveSampler progressive(importance, sampling(SamplingMode::Prioritized, 0.35));
+  SampledFrame last;
+  while (!progressive.converged()) last = progressive.next_frame(caster_trace_batch(caster));
+  const ImageRGBA converged = composite_frame(last.image, f.options.background);
+  for (std::size_t i = 0; i < full.size(); ++i) ASSERT_EQ(converged.pixels[i], full.pixels[i]);
+}
+
+TEST(VolumeSampling, BackgroundIsTheCastersExactTestAndFilledExactly) {
+  const Fixture& f = fixture();
+  const volume::RayCaster caster(f.volume, f.tf, f.camera, f.options);
+  const ImageF importance = frame_importance(caster, &torus_geometry(), contour_features());
+  std::size_t background = 0, lines = 0;
+  for (int y = 0; y < caster.height(); ++y)
+    for (int x = 0; x < caster.width(); ++x) {
+      const bool is_bg = caster.pixel_is_background(x, y);
+      ASSERT_EQ(importance(x, y) < 0, is_bg);
+      background += is_bg;
+      if (!is_bg) {
+        ASSERT_GE(importance(x, y), 0.0f);
+        ASSERT_LE(importance(x, y), 1.0f);
+        lines += importance(x, y) > 0.99f;
+      }
+    }
+  EXPECT_GT(background, 0u);
+  EXPECT_GT(lines, 0u) << "the torus contours must reach the importance";
+  const VolumeFrame frame =
+      render_volume_frame(caster, &torus_geometry(), contour_features(), sampling(SamplingMode::Prioritized, 0.3));
+  const Rgba bg{f.options.background.x, f.options.background.y, f.options.background.z, 0.0f};
+  for (std::size_t i = 0; i < importance.size(); ++i) {
+    if (importance.pixels[i] < 0) {
+      ASSERT_EQ(frame.image.pixels[i], bg);
+      ASSERT_EQ(frame.sampled.traced.pixels[i], 0);
+    }
+    ASSERT_TRUE(std::isfinite(frame.image.pixels[i].r) && std::isfinite(frame.image.pixels[i].a));
+  }
+  EXPECT_EQ(frame.sampled.full_rays, importance.size() - background);
+}
+
+TEST(VolumeSampling, SameImageForOneAndTwoThreads) {
+  const Fixture& f = fixture();
+  const volume::RayCaster caster(f.volume, f.tf, f.camera, f.options);
+  std::vector<ImageRGBA> images;
+  for (int threads : {1, 2}) {
+    tbb::task_arena arena(threads);
+    arena.execute([&] {
+      images.push_back(render_volume_frame(caster, &torus_geometry(), contour_features(),
+                                           sampling(SamplingMode::Prioritized, 0.25))
+                           .image);
+    });
+  }
+  for (std::size_t i = 0; i < images[0].size(); ++i) ASSERT_EQ(images[0].pixels[i], images[1].pixels[i]);
+}
+
+TEST(VolumeSampling, FeatureListParsing) {
+  EXPECT_TRUE(parse_feature_list("none").is_empty());
+  EXPECT_TRUE(parse_feature_list("contours").has(features::LineClass::Contour));
+  EXPECT_THROW(parse_feature_list("edges"), InvalidInput);
+}
+
+}  // namespace
+}  // namespace raysift::sampling
