@@ -184,6 +184,25 @@ TEST_F(SphereImportance, SerialAndThreadedBuffersAreIdentical) {
   EXPECT_EQ(a.values.pixels, b.values.pixels);
 }
 
+TEST(Importance, SampleUpsamplesBilinearlyAndNeverBlendsBackground) {
+  ImportanceBuffer b;
+  b.frame_width = 8;
+  b.frame_height = 4;
+  b.values = ImageF(4, 2, 0.0f);
+  b.values(0, 0) = 1.0f;
+  b.values(1, 0) = 0.5f;
+  b.values(3, 1) = -1.0f;
+  // Frame pixel (1, 0) has its centre at buffer coordinates (0.75, 0.25): in x 3/4 of buffer pixel 0 and
+  // 1/4 of pixel 1 (centres at 0.5 and 1.5); in y the row above the first is clamped to row 0.
+  EXPECT_FLOAT_EQ(sample_importance(b, 1, 0), 0.75f * 1.0f + 0.25f * 0.5f);
+  EXPECT_FLOAT_EQ(sample_importance(b, 0, 0), 1.0f);  // clamped at the border
+  // The frame pixel inside a background buffer pixel is background.
+  EXPECT_FLOAT_EQ(sample_importance(b, 7, 3), -1.0f);
+  // Next to it, the background neighbour is left out of the interpolation (no value below 0).
+  EXPECT_FLOAT_EQ(sample_importance(b, 5, 3), 0.0f);
+  EXPECT_FLOAT_EQ(sample_importance(b, 5, 2), 0.0f);
+}
+
 TEST(Importance, RejectsBadOptions) {
   const Camera cam(front_camera(5.0));
   ImportanceOptions o;

@@ -190,6 +190,37 @@ TEST_F(TorusLines, SerialAndThreadedExtractionAreIdentical) {
   EXPECT_EQ(remove_hidden_lines(a, depth, vs).segments.size(), remove_hidden_lines(b, depth).segments.size());
 }
 
+TEST(Lines, FacesAtNonManifoldVerticesAreSkipped) {
+  // Two spheres touching at one shared vertex (mirror images across the plane through it): that vertex
+  // has two separate face fans.
+  mesh::TriMesh m = mesh::make_icosphere(1.0, 3);
+  const auto n = std::uint32_t(m.vertex_count());
+  std::uint32_t touch = 0;
+  for (std::uint32_t v = 0; v < n; ++v)
+    if (m.positions[v].x > m.positions[touch].x) touch = v;
+  const float plane_x = m.positions[touch].x;
+  for (std::uint32_t v = 0; v < n; ++v) {
+    const Vec3f p = m.positions[v];
+    m.positions.push_back({2 * plane_x - p.x, p.y, p.z});
+  }
+  const std::size_t nf = m.triangle_count();
+  for (std::size_t f = 0; f < nf; ++f) {
+    auto t = m.triangles[f];
+    for (auto& v : t) v = v == touch ? touch : v + n;
+    m.triangles.push_back({t[0], t[2], t[1]});  // a mirror flips the winding
+  }
+  const mesh::MeshCurvature c = mesh::compute_curvature(m);
+  EXPECT_EQ(c.nonmanifold_vertices, 1u);
+  EXPECT_EQ(c.unreferenced_vertices, 1u);  // the mirrored copy of the shared vertex
+  const Camera cam(camera_at({plane_x, 0.3, 6.0}));
+  const FeatureLines lines = extract_lines(m, c, cam.eye());
+  EXPECT_GT(lines.count(LineClass::Contour), 100u);
+  for (const LineSegment& s : lines.segments) {
+    const auto& t = m.triangles[s.face];
+    EXPECT_TRUE(t[0] != touch && t[1] != touch && t[2] != touch) << "segment on a face at the non-manifold vertex";
+  }
+}
+
 TEST(Lines, ParsesClassNamesAndRejectsUnknownOnes) {
   const LineClassSet s = parse_line_classes("contours,ridges");
   EXPECT_TRUE(s.has(LineClass::Contour));
