@@ -4,7 +4,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <bitset>
 #include <cmath>
 
 #include "core/errors.h"
@@ -29,13 +28,28 @@ constexpr int kWords = kEdgeIds / 64;
 constexpr int kSlotShift = 11;              // encoded vertex reference: slot << 11 | local edge id
 static_assert(kEdgeIds <= (1 << kSlotShift), "edge id must fit below the slot bits");
 
-constexpr int region_index(int x, int y, int z) { return (z * kR + y) * kR + x; }
-constexpr int edge_id(int x, int y, int z, int axis) { return ((z * kB + y) * kB + x) * 3 + axis; }
+// z fastest, like OpenVDB's leaf buffers (offset = x << 6 | y << 3 | z), so a leaf row copies contiguously.
+constexpr int region_index(int x, int y, int z) { return (x * kR + y) * kR + z; }
+constexpr int edge_id(int x, int y, int z, int axis) { return ((x * kB + y) * kB + z) * 3 + axis; }
+constexpr std::uint32_t kFullRow = (1u << kR) - 1;
+
+/// Bit count without relying on the POPCNT instruction (the build targets baseline x86-64).
+inline int popcount64(std::uint64_t x) {
+  x = x - ((x >> 1) & 0x5555555555555555ull);
+  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+  x = (x + (x >> 4)) & 0x0F0F0F0F0F0F0F0Full;
+  return int((x * 0x0101010101010101ull) >> 56);
+}
 
 /// Orders block origins by (z, y, x); origins are multiples of 8, so 21 bits per axis cover ±2^23 voxels.
 std::uint64_t block_key(const openvdb::Coord& c) {
   auto field = [](int v) { return std::uint64_t((v >> 3) + (1 << 20)) & ((1u << 21) - 1); };
   return (field(c.z()) << 42) | (field(c.y()) << 21) | field(c.x());
+}
+
+openvdb::Coord block_origin(std::uint64_t key) {
+  auto coord = [](std::uint64_t field) { return (int(field & ((1u << 21) - 1)) - (1 << 20)) * kB; };
+  return openvdb::Coord(coord(key), coord(key >> 21), coord(key >> 42));
 }
 
 /// Per-block result of the first pass.
@@ -49,14 +63,16 @@ struct BlockOutput {
 
 /// The blocks to visit: every leaf block with active voxels, plus the blocks below it (−x, −y, −z and
 /// their combinations) whose cells reach into it. Active tiles above leaf level are covered block by block.
-std::vector<openvdb::Coord> collect_blocks(const Tree& tree) {
+std::vector<std::uint64_t> collect_blocks(const Tree& tree) {
   std::vector<std::uint64_t> keys;
-  std::vector<openvdb::Coord> origins;
   // needed bit d (d = 0..7, bit a = one block lower along axis a): the block origin − 8·d holds cells
   // with a corner among this block's active voxels.
   auto add = [&](const openvdb::Coord& origin, unsigned needed) {
+    constexpr int kLimit = (1 << 23) - 2 * kB;  // block_key holds ±2^20 blocks per axis
+    if (std::abs(origin.x()) > kLimit || std::abs(origin.y()) > kLimit || std::abs(origin.z()) > kLimit)
+      throw InvalidInput("marching cubes: active voxels beyond index ±2^23 are not supported");
     for (unsigned d = 0; d < 8; ++d)
-      if ((needed >> d) & 1u) origins.push_back(origin - openvdb::Coord(d & 1 ? kB : 0, d & 2 ? kB : 0, d & 4 ? kB : 0));
+      if ((needed >> d) & 1u) keys.push_back(block_key(origin - openvdb::Coord(d & 1 ? kB : 0, d & 2 ? kB : 0, d & 4 ? kB : 0)));
   };
   for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) {
     const auto& mask = leaf->getValueMask();
@@ -85,15 +101,9 @@ std::vector<openvdb::Coord> collect_blocks(const Tree& tree) {
       for (int y = box.min().y(); y <= box.max().y(); y += kB)
         for (int x = box.min().x(); x <= box.max().x(); x += kB) add(openvdb::Coord(x, y, z), 0xFFu);
   }
-  for (const auto& o : origins) keys.push_back(block_key(o));
-  std::vector<std::size_t> order(origins.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return keys[a] < keys[b]; });
-  std::vector<openvdb::Coord> sorted;
-  sorted.reserve(order.size());
-  for (std::size_t k = 0; k < order.size(); ++k)
-    if (k == 0 || keys[order[k]] != keys[order[k - 1]]) sorted.push_back(origins[order[k]]);
-  return sorted;
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  return keys;
 }
 
 /// Reads the (kB+1)^3 samples of a block; inactive voxels read as the background value.
@@ -108,18 +118,18 @@ void gather(const Accessor& acc, const openvdb::Coord& origin, float background,
       // Direct buffer access (offset = x << 6 | y << 3 | z): getValue() costs an out-of-line call per voxel.
       const float* data = leaf->buffer().data();
       const auto& mask = leaf->getValueMask();
-      for (int z = z0; z < z1; ++z)
+      for (int x = x0; x < x1; ++x)
         for (int y = y0; y < y1; ++y)
-          for (int x = x0; x < x1; ++x) {
+          for (int z = z0; z < z1; ++z) {
             const openvdb::Index n = openvdb::Index((x - x0) << 6 | (y - y0) << 3 | (z - z0));
             values[region_index(x, y, z)] = mask.isOn(n) ? data[n] : background;
           }
     } else {
       float tile = background;
       const float v = acc.probeValue(leaf_origin, tile) ? tile : background;
-      for (int z = z0; z < z1; ++z)
+      for (int x = x0; x < x1; ++x)
         for (int y = y0; y < y1; ++y)
-          for (int x = x0; x < x1; ++x) values[region_index(x, y, z)] = v;
+          for (int z = z0; z < z1; ++z) values[region_index(x, y, z)] = v;
     }
   }
 }
@@ -129,22 +139,36 @@ void gather(const Accessor& acc, const openvdb::Coord& origin, float background,
 void process_block(const Accessor& acc, const openvdb::math::Transform& xform, const openvdb::Coord& origin,
                    float background, double iso, BlockOutput& out) {
   float values[kRegion];
-  std::uint8_t inside[kRegion];
   gather(acc, origin, background, values);
-  int inside_count = 0;
-  for (int i = 0; i < kRegion; ++i) inside_count += inside[i] = values[i] >= iso;
-  if (inside_count == 0 || inside_count == kRegion) return;
+  // rows[x * kR + y]: bit z set when sample (x, y, z) is inside (value >= iso; NaN is outside).
+  std::uint32_t rows[kR * kR];
+  bool any_inside = false, any_outside = false;
+  for (int r = 0; r < kR * kR; ++r) {
+    std::uint32_t bits = 0;
+    for (int z = 0; z < kR; ++z) bits |= std::uint32_t(values[r * kR + z] >= iso) << z;
+    rows[r] = bits;
+    any_inside |= bits != 0;
+    any_outside |= bits != kFullRow;
+  }
+  if (!any_inside || !any_outside) return;
 
-  for (int z = 0; z < kB; ++z)
-    for (int y = 0; y < kB; ++y)
-      for (int x = 0; x < kB; ++x) {
-        const int i = region_index(x, y, z);
-        static constexpr int kStep[3] = {1, kR, kR * kR};
+  // Owned cut edges, in edge-id order (x, y, z, axis), with their vertices.
+  for (int x = 0; x < kB; ++x)
+    for (int y = 0; y < kB; ++y) {
+      const std::uint32_t r = rows[x * kR + y];
+      const std::uint32_t cut[3] = {(r ^ rows[(x + 1) * kR + y]) & 0xFFu, (r ^ rows[x * kR + y + 1]) & 0xFFu,
+                                    (r ^ (r >> 1)) & 0xFFu};
+      std::uint32_t any = cut[0] | cut[1] | cut[2];
+      while (any) {
+        const int z = __builtin_ctz(any);
+        any &= any - 1;
         for (int axis = 0; axis < 3; ++axis) {
-          if (inside[i] == inside[i + kStep[axis]]) continue;
+          if (!((cut[axis] >> z) & 1u)) continue;
           const int id = edge_id(x, y, z, axis);
           out.owned[id >> 6] |= std::uint64_t(1) << (id & 63);
           // Always interpolate from the lower end point, so the position does not depend on the cell.
+          static constexpr int kStep[3] = {kR * kR, kR, 1};
+          const int i = region_index(x, y, z);
           const double f0 = values[i], f1 = values[i + kStep[axis]];
           double t = (iso - f0) / (f1 - f0);
           if (!(t >= kEdgeClamp)) t = kEdgeClamp;  // also catches NaN
@@ -155,21 +179,26 @@ void process_block(const Accessor& acc, const openvdb::math::Transform& xform, c
           out.vertices.push_back({float(p_ws.x()), float(p_ws.y()), float(p_ws.z())});
         }
       }
+    }
   std::uint16_t running = 0;
   for (int w = 0; w < kWords; ++w) {
     out.rank[w] = running;
-    running = std::uint16_t(running + std::bitset<64>(out.owned[w]).count());
+    running = std::uint16_t(running + popcount64(out.owned[w]));
   }
   out.vertex_count = running;
 
   const auto& cases = detail::marching_cubes_cases();
-  for (int z = 0; z < kB; ++z)
-    for (int y = 0; y < kB; ++y)
-      for (int x = 0; x < kB; ++x) {
-        const int i = region_index(x, y, z);
-        const int c = inside[i] | inside[i + 1] << 1 | inside[i + kR] << 2 | inside[i + kR + 1] << 3 |
-                      inside[i + kR * kR] << 4 | inside[i + kR * kR + 1] << 5 | inside[i + kR * kR + kR] << 6 |
-                      inside[i + kR * kR + kR + 1] << 7;
+  for (int x = 0; x < kB; ++x)
+    for (int y = 0; y < kB; ++y) {
+      // Corner n of a cell sits at offset (n & 1, (n >> 1) & 1, (n >> 2) & 1): rows r00, r10, r01, r11 hold
+      // corners 0-3 at bit z and corners 4-7 at bit z + 1.
+      const std::uint32_t r00 = rows[x * kR + y], r10 = rows[(x + 1) * kR + y], r01 = rows[x * kR + y + 1],
+                          r11 = rows[(x + 1) * kR + y + 1];
+      if (r00 == r10 && r00 == r01 && r00 == r11 && (r00 == 0 || r00 == kFullRow)) continue;
+      for (int z = 0; z < kB; ++z) {
+        const int c = int(((r00 >> z) & 1u) | ((r10 >> z) & 1u) << 1 | ((r01 >> z) & 1u) << 2 | ((r11 >> z) & 1u) << 3 |
+                          ((r00 >> (z + 1)) & 1u) << 4 | ((r10 >> (z + 1)) & 1u) << 5 | ((r01 >> (z + 1)) & 1u) << 6 |
+                          ((r11 >> (z + 1)) & 1u) << 7);
         const detail::McCase& mc = cases[c];
         for (int k = 0; k < 3 * mc.triangle_count; ++k) {
           const int e = mc.edges[k], start = detail::kEdgeStart[e];
@@ -179,6 +208,7 @@ void process_block(const Accessor& acc, const openvdb::math::Transform& xform, c
               std::uint16_t(slot << kSlotShift | edge_id(px & 7, py & 7, pz & 7, detail::edge_axis(e))));
         }
       }
+    }
 }
 
 template <typename Fn>
@@ -231,7 +261,7 @@ mesh::TriMesh extract(const openvdb::FloatGrid& grid, const std::vector<openvdb:
       const std::uint64_t word = o.owned[id >> 6];
       RAYSIFT_DCHECK((word >> (id & 63)) & 1);
       const std::uint64_t below = word & ((std::uint64_t(1) << (id & 63)) - 1);
-      dst[k] = std::uint32_t(vertex_offset[std::size_t(owner[slot])] + o.rank[id >> 6] + std::bitset<64>(below).count());
+      dst[k] = std::uint32_t(vertex_offset[std::size_t(owner[slot])] + o.rank[id >> 6] + popcount64(below));
     }
   });
   if (options.flip_orientation)
@@ -248,9 +278,9 @@ std::vector<mesh::TriMesh> extract_isosurfaces(const Volume& volume, Span<const 
   if (volume.is_empty())
     throw InvalidInput("marching cubes: volume '" + volume.name() + "' has no active voxels; nothing to mesh");
   const openvdb::FloatGrid& grid = *volume.impl().grid;
-  const std::vector<openvdb::Coord> blocks = collect_blocks(grid.tree());
-  std::vector<std::uint64_t> keys(blocks.size());
-  for (std::size_t b = 0; b < blocks.size(); ++b) keys[b] = block_key(blocks[b]);
+  const std::vector<std::uint64_t> keys = collect_blocks(grid.tree());
+  std::vector<openvdb::Coord> blocks(keys.size());
+  for (std::size_t b = 0; b < keys.size(); ++b) blocks[b] = block_origin(keys[b]);
   std::vector<mesh::TriMesh> meshes;
   meshes.reserve(iso_values.size());
   for (const double iso : iso_values) meshes.push_back(extract(grid, blocks, keys, iso, options));
