@@ -48,9 +48,15 @@ struct VolumeBricks {
     return (std::int64_t(bz) * dims.y + by) * dims.x + bx;
   }
 
+  std::int64_t block_of(const Cell& c) const {
+    return block_index(c.ix >> kBlockLog2, c.iy >> kBlockLog2, c.iz >> kBlockLog2);
+  }
+
   /// Trilinear value at a cell; voxel (i,j,k)'s value sits at index point (i,j,k) (OpenVDB convention).
-  float sample(const Cell& c) const {
-    const std::int64_t b = block_index(c.ix >> kBlockLog2, c.iy >> kBlockLog2, c.iz >> kBlockLog2);
+  float sample(const Cell& c) const { return sample(c, block_of(c)); }
+
+  /// Same, with the cell's block number (block_of(c)) already known.
+  float sample(const Cell& c, std::int64_t b) const {
     if (b < 0) return background;
     const std::int32_t n = brick[std::size_t(b)];
     if (n < 0) return constant[std::size_t(b)];
