@@ -13,6 +13,8 @@
 namespace raysift::mesh {
 namespace {
 
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
+
 const char* error_name(RTCError code) {
   switch (code) {
     case RTC_ERROR_NONE: return "RTC_ERROR_NONE";
@@ -63,7 +65,7 @@ void context_filter(const RTCFilterFunctionNArguments* args) {
       args->valid[i] = 0;
       continue;
     }
-    if (!options.filter) continue;
+    if (!options.filter) continue;  // culling only: the common, hot case ends here
     c.ray_index = RTCRayN_id(args->ray, n, i);
     c.origin = {RTCRayN_org_x(args->ray, n, i), RTCRayN_org_y(args->ray, n, i), RTCRayN_org_z(args->ray, n, i)};
     c.t = RTCRayN_tfar(args->ray, n, i);
@@ -72,6 +74,15 @@ void context_filter(const RTCFilterFunctionNArguments* args) {
     c.v = RTCHitN_v(args->hit, n, i);
     if (!(*options.filter)(c)) args->valid[i] = 0;
   }
+}
+
+/// Culling-only closest-hit queries first run without any callback (bare Embree speed); only rays
+/// whose nearest hit is a back face are traced again with the culling filter. Both passes together
+/// return the nearest front-facing hit, as one culled traversal would.
+QueryOptions without_culling(const QueryOptions& options) {
+  QueryOptions plain = options;
+  plain.cull_back_faces = false;
+  return plain;
 }
 
 void init_context(FilterContext& ctx, const QueryOptions& options) {
@@ -83,9 +94,11 @@ void init_context(FilterContext& ctx, const QueryOptions& options) {
 }
 
 bool is_valid_ray(const RayF& r) {
-  return is_finite(r.origin) && is_finite(r.direction) && std::isfinite(r.t_near) && !std::isnan(r.t_far) &&
-         r.t_near >= 0.0f && r.t_near <= r.t_far && (r.direction.x != 0.0f || r.direction.y != 0.0f ||
-                                                     r.direction.z != 0.0f);
+  // x - x is 0 for finite x and NaN for NaN/Inf: one test per vector instead of three isfinite calls.
+  const float o = (r.origin.x - r.origin.x) + (r.origin.y - r.origin.y) + (r.origin.z - r.origin.z);
+  const float d = (r.direction.x - r.direction.x) + (r.direction.y - r.direction.y) + (r.direction.z - r.direction.z);
+  return o == 0.0f && d == 0.0f && r.t_near >= 0.0f && r.t_near <= r.t_far && r.t_near < kInfinity &&
+         (r.direction.x != 0.0f || r.direction.y != 0.0f || r.direction.z != 0.0f);
 }
 
 Hit hit_from(float t, unsigned geom_id, unsigned prim_id, float ng_x, float ng_y, float ng_z, float u, float v) {
@@ -218,24 +231,35 @@ std::size_t RayScene::degenerate_triangle_count() const { return impl_->degenera
 
 Hit RayScene::intersect(const RayF& ray, const QueryOptions& options) const {
   if (!is_valid_ray(ray)) return {};
+  const bool is_cull_only = options.cull_back_faces && !options.filter;
+  const QueryOptions first_pass = is_cull_only ? without_culling(options) : options;  // outlives ctx's use
   FilterContext ctx;
-  init_context(ctx, options);
+  init_context(ctx, first_pass);
   RTCRayHit rh;
-  rh.ray.org_x = ray.origin.x;
-  rh.ray.org_y = ray.origin.y;
-  rh.ray.org_z = ray.origin.z;
-  rh.ray.dir_x = ray.direction.x;
-  rh.ray.dir_y = ray.direction.y;
-  rh.ray.dir_z = ray.direction.z;
-  rh.ray.tnear = ray.t_near;
-  rh.ray.tfar = ray.t_far;
-  rh.ray.time = 0.0f;
-  rh.ray.mask = ~0u;
-  rh.ray.id = 0;
-  rh.ray.flags = 0;
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  const auto reset = [&] {
+    rh.ray.org_x = ray.origin.x;
+    rh.ray.org_y = ray.origin.y;
+    rh.ray.org_z = ray.origin.z;
+    rh.ray.dir_x = ray.direction.x;
+    rh.ray.dir_y = ray.direction.y;
+    rh.ray.dir_z = ray.direction.z;
+    rh.ray.tnear = ray.t_near;
+    rh.ray.tfar = ray.t_far;
+    rh.ray.time = 0.0f;
+    rh.ray.mask = ~0u;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  };
+  reset();
   rtcIntersect1(impl_->scene, &ctx.rtc, &rh);
+  if (is_cull_only && rh.hit.geomID != RTC_INVALID_GEOMETRY_ID &&
+      rh.hit.Ng_x * ray.direction.x + rh.hit.Ng_y * ray.direction.y + rh.hit.Ng_z * ray.direction.z >= 0.0f) {
+    reset();
+    init_context(ctx, options);
+    rtcIntersect1(impl_->scene, &ctx.rtc, &rh);
+  }
   return hit_from(rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z, rh.hit.u, rh.hit.v);
 }
 
@@ -268,10 +292,14 @@ void fill_packet(Ray16& r, int* valid, Span<const RayF> rays, std::size_t base, 
 void RayScene::intersect(Span<const RayF> rays, Span<Hit> hits, const QueryOptions& options) const {
   RAYSIFT_CHECK_OP(hits.size(), ==, rays.size());
   RAYSIFT_CHECK(rays.size() < std::size_t(std::numeric_limits<std::uint32_t>::max()));
-  FilterContext ctx;
-  init_context(ctx, options);
+  const bool is_cull_only = options.cull_back_faces && !options.filter;
+  const QueryOptions first_pass = is_cull_only ? without_culling(options) : options;  // outlives ctx's use
+  FilterContext ctx, cull_ctx;
+  init_context(ctx, first_pass);
+  init_context(cull_ctx, options);
   alignas(64) RTCRayHit16 rh;
   alignas(64) int valid[kPacket];
+  alignas(64) int again[kPacket];
   for (std::size_t base = 0; base < rays.size(); base += kPacket) {
     const std::size_t count = std::min(kPacket, rays.size() - base);
     fill_packet(rh.ray, valid, rays, base, count);
@@ -280,6 +308,20 @@ void RayScene::intersect(Span<const RayF> rays, Span<Hit> hits, const QueryOptio
       rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
     }
     rtcIntersect16(valid, impl_->scene, &ctx.rtc, &rh);
+    if (is_cull_only) {
+      bool has_back_face = false;
+      for (std::size_t i = 0; i < kPacket; ++i) {
+        const bool is_back = valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID &&
+                             rh.hit.Ng_x[i] * rh.ray.dir_x[i] + rh.hit.Ng_y[i] * rh.ray.dir_y[i] +
+                                     rh.hit.Ng_z[i] * rh.ray.dir_z[i] >= 0.0f;
+        again[i] = is_back ? -1 : 0;
+        if (!is_back) continue;
+        has_back_face = true;
+        rh.ray.tfar[i] = rays[base + i].t_far;
+        rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+      }
+      if (has_back_face) rtcIntersect16(again, impl_->scene, &cull_ctx.rtc, &rh);
+    }
     for (std::size_t i = 0; i < count; ++i)
       hits[base + i] = valid[i] ? hit_from(rh.ray.tfar[i], rh.hit.geomID[i], rh.hit.primID[i], rh.hit.Ng_x[i],
                                            rh.hit.Ng_y[i], rh.hit.Ng_z[i], rh.hit.u[i], rh.hit.v[i])

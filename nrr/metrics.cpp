@@ -97,8 +97,14 @@ SamplingMetrics compute_sampling_metrics(const SampledScene& scene, SamplingMode
     const std::size_t last = mode == SamplingMode::Peel ? conventional.size() : i + 1;
     m.images[i].disoccluded = count_if_index(im.pixel_count(), threaded, [&](std::size_t p) {
       if (!im.has_sample(p)) return false;
-      for (std::size_t j = first; j < last; ++j)
-        if (captured(conventional[j], conv_cameras[j], im.position_ws[p], im.triangle_id[p])) return false;
+      for (std::size_t j = first; j < last; ++j) {
+        // Same view, pixel redundancy: the sample reprojects onto its own pixel, so compare there
+        // directly (also right for hits at t = 0, which cannot be projected).
+        const bool is_same_view = by_pixel && j == i && mode != SamplingMode::Peel;
+        if (is_same_view ? conventional[j].triangle_id[p] == im.triangle_id[p]
+                         : captured(conventional[j], conv_cameras[j], im.position_ws[p], im.triangle_id[p]))
+          return false;
+      }
       cls[p] = SampleClass::Disoccluded;
       return true;
     });
@@ -109,7 +115,16 @@ SamplingMetrics compute_sampling_metrics(const SampledScene& scene, SamplingMode
     for (std::size_t p = 0; p < m.sample_classes[i].size(); ++p)
       if (m.sample_classes[i][p] == SampleClass::Disoccluded) disoccluded.emplace_back(i, p);
 
+  // Conventional and visibility-NRR images hold every point visible from one of their eyes (a point
+  // visible from V_j is in I_j or, being redundant, in an earlier image): a cheap occlusion ray settles
+  // most samples before the full rule is traced. For conventional images the rule adds nothing more.
+  const bool holds_all_visible = mode == SamplingMode::Conventional || mode == SamplingMode::NrrVisibility;
   const auto is_available = [&](const Vec3f& x, mesh::TriangleId id) {
+    if (!by_pixel && holds_all_visible) {
+      for (const Camera& cam : ref_cameras)
+        if (detail::visible_from(scene, cam, x, id)) return true;
+      if (mode == SamplingMode::Conventional) return false;
+    }
     for (std::size_t i = 0; i < n; ++i) {
       if (by_pixel) {
         if (detail::pixel_captured(reference[i], ref_cameras[i], x, id)) return true;

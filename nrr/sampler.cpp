@@ -1,6 +1,7 @@
 #include "nrr/sampler.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/errors.h"
 #include "nrr/detail/tracer.h"
@@ -25,28 +26,51 @@ std::string to_string(SamplingMode mode) {
   return "?";
 }
 
-SampledScene::SampledScene(const mesh::TriMesh& mesh)
-    : rays_(mesh), triangles_(mesh.triangles), vertex_normals_(mesh.vertex_count()) {
-  face_normals_.reserve(mesh.triangle_count());
-  std::vector<Vec3d> accumulated(mesh.vertex_count());
+namespace {
+/// Faces meeting at a vertex at more than this angle do not share a shading normal there, so box
+/// edges stay sharp while finely tessellated curved surfaces shade smoothly.
+constexpr double kCreaseAngleDeg = 45.0;
+/// A triangle whose corner normals all lie within this of its face normal is shaded flat (the Embree
+/// normal is used and the corner normals are never read: faster on boxy scenes).
+constexpr double kFlatCosine = 1.0 - 1e-6;
+}  // namespace
+
+SampledScene::SampledScene(const mesh::TriMesh& mesh) : rays_(mesh) {
+  const std::size_t n_tris = mesh.triangle_count();
+  face_normals_.reserve(n_tris);
+  std::vector<Vec3d> area_normals;
+  area_normals.reserve(n_tris);
+  std::vector<std::vector<std::uint32_t>> faces_of_vertex(mesh.vertex_count());
   double edge_sum = 0.0;
-  for (const auto& tri : mesh.triangles) {
+  for (std::size_t t = 0; t < n_tris; ++t) {
+    const auto& tri = mesh.triangles[t];
     const Vec3d p0(mesh.positions[tri[0]]), p1(mesh.positions[tri[1]]), p2(mesh.positions[tri[2]]);
-    const Vec3d area_normal = cross(p1 - p0, p2 - p0);  // length = twice the area: area weighting
-    face_normals_.push_back(normalize(area_normal));
-    for (std::uint32_t v : tri) accumulated[v] += area_normal;
+    area_normals.push_back(cross(p1 - p0, p2 - p0));  // length = twice the area: area weighting
+    face_normals_.push_back(normalize(area_normals.back()));
+    for (std::uint32_t v : tri) faces_of_vertex[v].push_back(std::uint32_t(t));
     edge_sum += length(p1 - p0) + length(p2 - p1) + length(p0 - p2);
   }
-  for (std::size_t v = 0; v < accumulated.size(); ++v) vertex_normals_[v] = Vec3f(normalize(accumulated[v]));
-  mean_edge_ = edge_sum / (3.0 * double(mesh.triangle_count()));
+  const double crease_cos = std::cos(kCreaseAngleDeg * M_PI / 180.0);
+  corner_normals_.resize(n_tris);
+  is_flat_.assign(n_tris, 1);
+  for (std::size_t t = 0; t < n_tris; ++t)
+    for (int k = 0; k < 3; ++k) {
+      Vec3d sum;
+      for (std::uint32_t f : faces_of_vertex[mesh.triangles[t][k]])
+        if (dot(face_normals_[f], face_normals_[t]) >= crease_cos) sum += area_normals[f];
+      const Vec3d n = normalize(sum);
+      corner_normals_[t][k] = Vec3f(n);
+      if (dot(n, face_normals_[t]) < kFlatCosine) is_flat_[t] = 0;
+    }
+  mean_edge_ = edge_sum / (3.0 * double(n_tris));
 }
 
-Vec3f SampledScene::shading_normal(mesh::TriangleId id, float u, float v) const {
-  const auto& tri = triangles_[mesh::triangle_id_index(id)];
-  const Vec3f n = normalize(vertex_normals_[tri[0]] * (1.0f - u - v) + vertex_normals_[tri[1]] * u +
-                            vertex_normals_[tri[2]] * v);
-  const Vec3f face(face_normal(id));
-  return dot(n, face) > 0.0f ? n : face;
+Vec3f SampledScene::shading_normal(mesh::TriangleId id, float u, float v, const Vec3f& face_normal) const {
+  const std::uint32_t t = mesh::triangle_id_index(id);
+  if (is_flat_[t]) return face_normal;
+  const auto& c = corner_normals_[t];
+  const Vec3f n = normalize(c[0] * (1.0f - u - v) + c[1] * u + c[2] * v);
+  return dot(n, face_normal) > 0.0f ? n : face_normal;
 }
 
 CameraSpec peel_camera(Span<const CameraSpec> views) {

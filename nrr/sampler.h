@@ -22,7 +22,8 @@ enum class SamplingMode { Conventional, NrrPixel, NrrVisibility, Peel };
 SamplingMode parse_sampling_mode(const std::string& name);
 std::string to_string(SamplingMode mode);
 
-/// A mesh prepared for sampling: its Embree scene, triangle normals and area-weighted vertex normals.
+/// A mesh prepared for sampling: its Embree scene, triangle normals and per-corner shading normals
+/// (area-weighted over the faces around the vertex within a 45 degree crease angle).
 /// @warning Immutable after construction; all queries are thread-safe.
 class SampledScene {
  public:
@@ -32,9 +33,9 @@ class SampledScene {
   const mesh::RayScene& rays() const { return rays_; }
   /// Unit normal of the CCW front face (zero for a degenerate triangle).
   const Vec3d& face_normal(mesh::TriangleId id) const { return face_normals_[mesh::triangle_id_index(id)]; }
-  /// Interpolated vertex normal at barycentrics (u, v); the face normal where that is zero or faces
-  /// the other way (e.g. a crease shared by the two sides of a thin sheet).
-  Vec3f shading_normal(mesh::TriangleId id, float u, float v) const;
+  /// Corner normals interpolated at barycentrics (u, v); `face_normal` (the unit normal of triangle
+  /// `id`, e.g. mesh::Hit::normal_ws) for flat triangles or where the interpolation faces away.
+  Vec3f shading_normal(mesh::TriangleId id, float u, float v, const Vec3f& face_normal) const;
   /// Scene bounding-box diagonal, world units.
   double diagonal() const { return rays_.bounds().diagonal(); }
   /// Mean triangle edge length, world units (for the triangle-size / pixel-size ratio in reports).
@@ -42,9 +43,9 @@ class SampledScene {
 
  private:
   mesh::RayScene rays_;
-  std::vector<std::array<std::uint32_t, 3>> triangles_;
   std::vector<Vec3d> face_normals_;
-  std::vector<Vec3f> vertex_normals_;
+  std::vector<std::array<Vec3f, 3>> corner_normals_;  ///< per triangle, normals at its corners
+  std::vector<std::uint8_t> is_flat_;                 ///< per triangle: corner normals == face normal
   double mean_edge_ = 0.0;
 };
 

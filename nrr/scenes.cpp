@@ -81,6 +81,7 @@ GeneratedScene make_blocks4() {
 }
 
 constexpr int kTrianglesPerBlade = 10;
+constexpr double kBladeThickness = 1e-3;  ///< world units; blades are 0.04-0.08 wide
 constexpr int kTrianglesPerBuilding = 10;
 
 GeneratedScene make_grass(std::uint64_t seed, std::size_t triangles) {
@@ -111,9 +112,10 @@ GeneratedScene make_grass(std::uint64_t seed, std::size_t triangles) {
     add_quad(m, front[2], front[3], front[5], front[4]);
     m.triangles.push_back({front[4], front[5], front[6]});
     // Blades are thin sheets seen from both sides under back-face culling: the back is a second copy
-    // with its own vertices (so vertex normals do not cancel) and reversed winding.
+    // with its own vertices and reversed winding, kBladeThickness behind the front, so that from
+    // either side the nearest hit is a front face (a closed thin slab but for its rim).
     std::uint32_t back[7];
-    for (int k = 0; k < 7; ++k) back[k] = add_vertex(m, Vec3d(m.positions[front[k]]));
+    for (int k = 0; k < 7; ++k) back[k] = add_vertex(m, Vec3d(m.positions[front[k]]) - normal * kBladeThickness);
     for (std::size_t t = first; t < first + 5; ++t) {
       const auto tri = m.triangles[t];
       const auto remap = [&](std::uint32_t v) { return back[v - front[0]]; };

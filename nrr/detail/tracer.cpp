@@ -177,6 +177,12 @@ void for_each_tile(const Camera& camera, bool threaded,
   const int w = camera.width(), h = camera.height();
   const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
   const Vec3f eye(camera.eye());
+  // Directions are separable: forward + sx(x) * right + sy(y) * up, so a tile needs one column and one
+  // row term per pixel instead of a full camera evaluation.
+  std::vector<Vec3d> column(static_cast<std::size_t>(w)), row(static_cast<std::size_t>(h));
+  const Vec3d centre = camera.direction_unit_depth(0.5 * w, 0.5 * h);
+  for (int x = 0; x < w; ++x) column[std::size_t(x)] = camera.direction_unit_depth(x + 0.5, 0.5 * h) - centre;
+  for (int y = 0; y < h; ++y) row[std::size_t(y)] = camera.direction_unit_depth(0.5 * w, y + 0.5);
   const auto run = [&](int tile) {
     std::vector<mesh::RayF> rays;
     std::vector<std::size_t> pixels;
@@ -187,7 +193,7 @@ void for_each_tile(const Camera& camera, bool threaded,
       for (int bx = x0; bx < std::min(x0 + kTile, w); bx += kBlock)
         for (int y = by; y < std::min(by + kBlock, h); ++y)
           for (int x = bx; x < std::min(bx + kBlock, w); ++x) {
-            rays.push_back({eye, Vec3f(camera.direction_unit_depth(x + 0.5, y + 0.5))});
+            rays.push_back({eye, Vec3f(row[std::size_t(y)] + column[std::size_t(x)])});
             pixels.push_back(std::size_t(y) * std::size_t(w) + std::size_t(x));
           }
     fn(Span<const mesh::RayF>(rays), Span<const std::size_t>(pixels));
@@ -207,7 +213,7 @@ void store_sample(const SampledScene& scene, const mesh::RayF& ray, const mesh::
   if (!h.is_hit()) return;
   image.depth[pixel] = h.t;
   image.triangle_id[pixel] = h.triangle_id;
-  image.normal_ws[pixel] = scene.shading_normal(h.triangle_id, h.u, h.v);
+  image.normal_ws[pixel] = scene.shading_normal(h.triangle_id, h.u, h.v, h.normal_ws);
   image.position_ws[pixel] = sample_position(ray, h.t);
 }
 
