@@ -2,13 +2,18 @@
 // plus reducing its depth and warping the map to the next camera of a 60-frame orbit) against the
 // full-quality ray-cast of the same 1440x900 view, measured in the same run. Target: <= 5 %.
 //
-// Usage: saliency_bench [VOLUME.vdb [TF.json [CAMERA.json]]]  (default: datasets/engine_ct{.vdb,_tf.json,_camera.json};
-// the camera is rendered at 1440x900)
+// Part 2 (RP paper §5, issue 9): an orbit of N frames (default 60) around the same view with
+// --target-fps set to 3x the measured full-render rate, contours + silhouettes as line features, with and
+// without saliency: the share of frames within +10 % of the target time and the mean SSIM vs full renders.
+//
+// Usage: saliency_bench [--frames N] [--per-frame] [VOLUME.vdb [TF.json [CAMERA.json]]]
+//   (default: datasets/engine_ct{.vdb,_tf.json,_camera.json}; the camera is rendered at 1440x900; N = 0 skips part 2)
 #include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -17,6 +22,8 @@
 #include "core/timer.h"
 #include "features/saliency.h"
 #include "features/warp.h"
+#include "sampling/camera_path.h"
+#include "sampling/volume_sampling.h"
 #include "volume/raycaster.h"
 #include "volume/transfer_function.h"
 #include "volume/vdb_io.h"
@@ -48,13 +55,65 @@ CameraSpec orbit_step(CameraSpec spec, double angle_deg) {
   return spec;
 }
 
+/// Part 2: the target-fps orbit with and without saliency.
+void run_orbit(const volume::Volume& vol, const volume::TransferFunction& tf, const CameraSpec& start, int frames,
+               double full_ms, bool per_frame) {
+  const double target_fps = 3.0 * 1000.0 / full_ms;
+  Timer timer;
+  const sampling::FeatureGeometry geometry = sampling::build_feature_geometry(vol, tf);
+  std::printf("\norbit: %d frames, target %.2f fps (3x the full render), feature geometry %zu triangles in %.0f ms\n",
+              frames, target_fps, geometry.mesh.triangles.size(), timer.elapsed_ms());
+  std::vector<CameraSpec> cameras;
+  for (int i = 0; i < frames; ++i) cameras.push_back(orbit_step(start, 360.0 * i / frames));
+  std::printf("%-26s %10s %10s %10s %12s %10s\n", "features", "within10%", "mean ms", "mean rays", "mean SSIM",
+              "sal. ms");
+  for (const bool use_saliency : {false, true}) {
+    sampling::PathRenderOptions opt;
+    opt.sampling.mode = sampling::SamplingMode::Prioritized;
+    opt.features.lines.classes = sampling::parse_feature_list("contours,silhouettes");
+    opt.features.use_saliency = use_saliency;
+    opt.target_fps = target_fps;
+    opt.compare_full = true;
+    const auto path = sampling::render_camera_path(vol, tf, {}, cameras, &geometry, opt,
+                                                   [](const sampling::PathFrame&, const ImageRGBA&) {});
+    const Json stats = sampling::path_stats_json(path, target_fps);
+    double ms = 0, rays = 0, saliency = 0;
+    for (const sampling::PathFrame& f : path) {
+      if (per_frame)
+        std::printf("  frame %2d: %8.1f ms (saliency %5.1f), rays %7zu / %7zu, alpha00 %+.4f, SSIM %.4f\n", f.index,
+                    f.ms, f.saliency_ms, f.rays_traced, f.full_rays, double(f.alpha00), f.ssim_vs_full);
+      ms += f.ms;
+      rays += double(f.rays_traced) / double(std::max<std::size_t>(f.full_rays, 1));
+      saliency += f.saliency_ms;
+    }
+    const double n = double(path.size());
+    std::printf("%-26s %9.0f%% %10.1f %9.1f%% %12.4f %10.1f\n",
+                use_saliency ? "contours+sil + saliency" : "contours+silhouettes",
+                100.0 * stats.at("within_10pct_of_target").get<double>(), ms / n, 100.0 * rays / n,
+                stats.at("mean_ssim_vs_full").get<double>(), saliency / n);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress shows up when redirected to a file
+  int orbit_frames = 60;
+  bool per_frame = false;
+  std::vector<std::string> args;
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--frames" && i + 1 < argc) {
+      orbit_frames = std::atoi(argv[++i]);
+    } else if (std::string(argv[i]) == "--per-frame") {
+      per_frame = true;
+    } else {
+      args.emplace_back(argv[i]);
+    }
+  }
   const std::string data = std::string(RAYSIFT_SOURCE_DIR) + "/datasets/";
-  const std::string vdb_path = argc > 1 ? argv[1] : data + "engine_ct.vdb";
-  const std::string tf_path = argc > 2 ? argv[2] : data + "engine_ct_tf.json";
-  const std::string camera_path = argc > 3 ? argv[3] : data + "engine_ct_camera.json";
+  const std::string vdb_path = args.size() > 0 ? args[0] : data + "engine_ct.vdb";
+  const std::string tf_path = args.size() > 1 ? args[1] : data + "engine_ct_tf.json";
+  const std::string camera_path = args.size() > 2 ? args[2] : data + "engine_ct_camera.json";
   try {
     const volume::Volume vol = volume::load_vdb(vdb_path);
     const volume::TransferFunction tf = volume::load_transfer_function(tf_path);
@@ -99,6 +158,7 @@ int main(int argc, char** argv) {
                 warped.n_disoccluded);
     std::printf("%-34s %10.2f   = %.2f %% of the full render (target <= 5 %%)\n", "saliency + warp", total,
                 100.0 * total / render_ms);
+    if (orbit_frames > 0) run_orbit(vol, tf, prev_spec, orbit_frames, render_ms, per_frame);
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "saliency_bench: error: %s\n", e.what());

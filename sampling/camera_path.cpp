@@ -1,10 +1,21 @@
 #include "sampling/camera_path.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <memory>
+#include <optional>
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/timer.h"
+#include "features/warp.h"
+#include "sampling/frame_rate.h"
+#include "sampling/metrics.h"
 
 namespace raysift::sampling {
 namespace {
@@ -57,6 +68,82 @@ std::pair<std::size_t, std::size_t> find_conversion(const std::string& pattern, 
   }
   return found;
 }
+
+/// Bilinear value of `map` (covering the whole frame at its own resolution) at the centre of frame
+/// pixel (x, y); clamped at the border.
+float sample_map(const ImageF& map, int x, int y, int frame_w, int frame_h) {
+  const double fx = std::clamp((x + 0.5) * map.width / frame_w - 0.5, 0.0, double(map.width - 1));
+  const double fy = std::clamp((y + 0.5) * map.height / frame_h - 0.5, 0.0, double(map.height - 1));
+  const int x0 = int(fx), y0 = int(fy);
+  const int x1 = std::min(x0 + 1, map.width - 1), y1 = std::min(y0 + 1, map.height - 1);
+  const float tx = float(fx - x0), ty = float(fy - y0);
+  const float top = map(x0, y0) + tx * (map(x1, y0) - map(x0, y0));
+  const float bottom = map(x0, y1) + tx * (map(x1, y1) - map(x0, y1));
+  return top + ty * (bottom - top);
+}
+
+/// Every ray traced since the camera last moved: colour, depth and whether it is known. A still camera
+/// re-selects a superset of the pixels of the frame before (α00 only grows), so those come from here
+/// for free and only the new rays are traced (RP paper §5: "the rays traced in the previous frame are
+/// reused").
+struct RayCache {
+  ImageRGBA colour;
+  ImageF depth;
+  std::vector<std::uint8_t> known;
+  std::size_t traced = 0;
+
+  RayCache(int w, int h)
+      : colour(w, h), depth(w, h, std::numeric_limits<float>::infinity()), known(std::size_t(w) * std::size_t(h), 0) {}
+};
+
+/// A batch tracer over `cache`: known pixels are copied, the others traced (their colour and depth
+/// stored). Calls touch disjoint pixels (scheduler contract), so the cache needs no lock; `new_rays`
+/// counts what was actually traced.
+TraceBatch cached_trace(const volume::RayCaster& caster, RayCache& cache, std::atomic<std::size_t>& new_rays) {
+  return [&caster, &cache, &new_rays](Span<const std::uint32_t> pixels, Span<Rgba> out) {
+    std::array<std::uint32_t, kRayGroup> todo{};
+    std::array<std::size_t, kRayGroup> slot{};
+    std::array<volume::RaySample, kRayGroup> samples;
+    for (std::size_t first = 0; first < pixels.size(); first += kRayGroup) {
+      const std::size_t n = std::min(kRayGroup, pixels.size() - first);
+      std::size_t m = 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        const std::uint32_t p = pixels[first + i];
+        if (cache.known[p]) {
+          out[first + i] = cache.colour.pixels[p];
+        } else {
+          todo[m] = p;
+          slot[m++] = first + i;
+        }
+      }
+      caster.trace_pixels(Span<const std::uint32_t>(todo.data(), m), Span<volume::RaySample>(samples.data(), m));
+      for (std::size_t k = 0; k < m; ++k) {
+        out[slot[k]] = cache.colour.pixels[todo[k]] = samples[k].color;
+        cache.depth.pixels[todo[k]] = samples[k].depth;
+        cache.known[todo[k]] = 1;
+      }
+      new_rays += m;
+    }
+  };
+}
+
+/// Mean SSIM (metrics.h ssim_map) over the pixels that have a full window.
+double mean_ssim(const ImageRGBA& reference, const ImageRGBA& test) {
+  const ImageF map = ssim_map(reference, test);
+  double sum = 0;
+  std::size_t n = 0;
+  for (float v : map.pixels)
+    if (std::isfinite(v)) {
+      sum += v;
+      ++n;
+    }
+  return n > 0 ? sum / double(n) : std::numeric_limits<double>::quiet_NaN();
+}
+
+/// Priority units added to α00 per frame while the camera stands still and no frame rate is targeted
+/// ([choice]; the RP paper only says α00 is increased): ten frames take the default mapping from level 0
+/// to every ray.
+constexpr float kRefineStep = 0.2f;
 
 }  // namespace
 
@@ -178,6 +265,153 @@ std::string frame_file_name(const std::string& pattern, int index) {
     return out;
   };
   return unescape(pattern.substr(0, begin)) + number + unescape(pattern.substr(end));
+}
+
+ImageF path_frame_importance(const volume::RayCaster& caster, const FeatureGeometry* geometry,
+                             const PathFeatureOptions& options, const PreviousFrame* previous, int base_spacing,
+                             double* saliency_ms) {
+  ImageF importance = frame_importance(caster, geometry, options.lines);
+  if (saliency_ms != nullptr) *saliency_ms = 0;
+  if (!options.use_saliency || previous == nullptr) return importance;
+  const Timer timer;
+  const ImageF map = features::compute_saliency(previous->image, options.saliency);
+  features::WarpOptions warp;
+  // Hole closing searches as far as the previous frame's coarsest sampling spacing, at map scale.
+  warp.hole_radius_px = base_spacing * double(map.width) / double(previous->image.width);
+  const features::WarpResult warped =
+      features::warp_map(map, features::downsample_depth(previous->depth, map.width, map.height),
+                         Camera(previous->camera), caster.camera(), warp);
+  const int w = importance.width, h = importance.height;
+  tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y < rows.end(); ++y)
+      for (int x = 0; x < w; ++x)
+        if (importance(x, y) >= 0.f) importance(x, y) = std::max(importance(x, y), sample_map(warped.map, x, y, w, h));
+  });
+  if (saliency_ms != nullptr) *saliency_ms = timer.elapsed_ms();
+  return importance;
+}
+
+std::vector<PathFrame> render_camera_path(const volume::Volume& volume, const volume::TransferFunction& tf,
+                                          const volume::RenderOptions& render, const std::vector<CameraSpec>& cameras,
+                                          const FeatureGeometry* geometry, const PathRenderOptions& options,
+                                          const PathFrameSink& sink) {
+  if (cameras.empty()) throw InvalidInput("camera path: no cameras (0 frames)");
+  validate(options.sampling);
+  const SamplingMode mode = options.sampling.mode;
+  std::optional<FrameRateController> controller;
+  if (options.target_fps != 0) {
+    if (mode != SamplingMode::Prioritized)
+      throw InvalidInput("--target-fps needs --mode prioritized, got --mode " + std::string(sampling_mode_name(mode)));
+    if (options.sampling.budget_ms > 0)
+      throw InvalidInput("--target-fps adapts alpha00 and cannot be combined with a per-frame time budget; give one");
+    FrameRateOptions fo;
+    fo.target_fps = options.target_fps;
+    fo.threshold = std::isfinite(options.sampling.threshold) ? options.sampling.threshold : fo.threshold;
+    fo.initial_alpha00 = options.sampling.mapping.alpha[0];
+    controller.emplace(fo);  // validates target_fps
+  }
+  // A still camera refines in threshold mode (α00 grows), so it needs a threshold even without a target.
+  const float threshold = controller ? controller->threshold()
+                                     : (std::isfinite(options.sampling.threshold) ? options.sampling.threshold : 1.0f);
+
+  std::vector<PathFrame> frames;
+  std::optional<PreviousFrame> previous;
+  std::unique_ptr<RayCache> cache;
+  std::unique_ptr<FractalPattern> pattern;
+  ImageF still_importance;  // importance of the first frame since the camera stopped
+  float alpha00 = options.sampling.mapping.alpha[0];
+  FrameTiming last_timing;
+  for (std::size_t i = 0; i < cameras.size(); ++i) {
+    const CameraSpec& spec = cameras[i];
+    // Building the caster stands in for an interactive camera update; it is not part of the frame time.
+    const volume::RayCaster caster(volume, tf, spec, render);
+    const int w = caster.width(), h = caster.height();
+    PathFrame frame;
+    frame.index = int(i);
+    frame.refined = previous.has_value() && same_camera(previous->camera, spec);
+    ImageRGBA image;
+    const Timer clock;
+    if (mode == SamplingMode::Full) {
+      if (frame.refined) {
+        image = previous->image;  // nothing left to refine: the frame is already complete
+      } else {
+        volume::RenderResult r = volume::render_full(caster);
+        image = std::move(r.image);
+        frame.rays_traced = std::size_t(r.rays_traced);
+        cache = std::make_unique<RayCache>(w, h);
+        cache->depth = std::move(r.depth);
+      }
+      frame.full_rays = std::size_t(w) * std::size_t(h);
+    } else {
+      if (!frame.refined) {
+        cache = std::make_unique<RayCache>(w, h);
+        if (!pattern || pattern->level.width != w || pattern->level.height != h)
+          pattern = std::make_unique<FractalPattern>(make_fractal_pattern(w, h, options.sampling.base_spacing));
+        still_importance = path_frame_importance(caster, geometry, options.features,
+                                                 previous ? &*previous : nullptr, options.sampling.base_spacing,
+                                                 &frame.saliency_ms);
+      }
+      SamplingOptions so = options.sampling;
+      if (mode == SamplingMode::Prioritized) {
+        if (controller) {
+          if (!frames.empty())
+            alpha00 = controller->update(last_timing, RayCountCurve(still_importance, *pattern, so.mapping, threshold),
+                                         frame.refined ? cache->traced : 0);
+          if (frame.refined) alpha00 = std::max(alpha00, frames.back().alpha00);
+        } else if (frame.refined) {
+          alpha00 = frames.back().alpha00 + kRefineStep;
+        }
+        if (controller || frame.refined) {
+          so.threshold = threshold;
+          so.mapping.alpha[0] = alpha00;
+        }
+        frame.alpha00 = so.mapping.alpha[0];
+      }
+      std::atomic<std::size_t> new_rays{0};
+      const SampledFrame s =
+          render_sampled(still_importance, cached_trace(caster, *cache, new_rays), so, clock.elapsed_ms());
+      cache->traced += new_rays;
+      frame.rays_traced = new_rays;
+      frame.full_rays = s.full_rays;
+      image = composite_frame(s.image, caster.options().background);
+      last_timing = {0, s.trace_ms, new_rays};
+    }
+    frame.ms = clock.elapsed_ms();
+    last_timing.frame_ms = frame.ms;
+    if (options.compare_full) frame.ssim_vs_full = mean_ssim(volume::render_full(caster).image, image);
+    sink(frame, image);
+    frames.push_back(frame);
+    if (!frame.refined) previous = PreviousFrame{spec, ImageRGBA(), ImageF()};
+    previous->image = std::move(image);
+    previous->depth = cache->depth;
+  }
+  return frames;
+}
+
+Json path_stats_json(const std::vector<PathFrame>& frames, double target_fps) {
+  Json list = Json::array();
+  double ssim_sum = 0;
+  std::size_t ssim_n = 0, within = 0;
+  const double target_ms = target_fps > 0 ? 1000.0 / target_fps : 0;
+  for (const PathFrame& f : frames) {
+    Json j = {{"index", f.index},           {"ms", f.ms},           {"rays_traced", f.rays_traced},
+              {"full_rays", f.full_rays},   {"alpha00", f.alpha00}, {"refined", f.refined},
+              {"saliency_ms", f.saliency_ms}};
+    j["ssim_vs_full"] = std::isfinite(f.ssim_vs_full) ? Json(f.ssim_vs_full) : Json(nullptr);
+    if (std::isfinite(f.ssim_vs_full)) {
+      ssim_sum += f.ssim_vs_full;
+      ++ssim_n;
+    }
+    if (target_ms > 0 && f.ms <= 1.1 * target_ms) ++within;
+    list.push_back(j);
+  }
+  Json stats = {{"frames", list}};
+  if (target_ms > 0) {
+    stats["target_ms"] = target_ms;
+    stats["within_10pct_of_target"] = frames.empty() ? 0.0 : double(within) / double(frames.size());
+  }
+  if (ssim_n > 0) stats["mean_ssim_vs_full"] = ssim_sum / double(ssim_n);
+  return stats;
 }
 
 }  // namespace raysift::sampling

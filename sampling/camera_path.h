@@ -1,15 +1,21 @@
 #pragma once
 /// \file Camera paths for rendering sequences (`raysift render --camera-path`): an explicit list of
-/// cameras or an orbit, plus the printf-style frame file names. Key design decision: a path is just a
-/// vector of validated CameraSpec, so every render mode works on it unchanged; what a frame inherits
-/// from the previous one (saliency, depth, reused rays) is decided by the path renderer
-/// (sampling/path_render.h), not here.
+/// cameras or an orbit, the printf-style frame file names, and the path renderer that carries
+/// information from frame to frame (RP paper §4.1, §5, §7.5): the previous frame's saliency warped with
+/// its depth, the target-fps controller, and progressive refinement while the camera stands still. Key
+/// design decision: a path is just a vector of validated CameraSpec and every frame goes through the
+/// same single-frame machinery (render_full / render_sampled / ProgressiveSampler), so every mode works
+/// on a path and a one-frame path equals a single render.
+#include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "core/camera.h"
 #include "core/json_io.h"
 #include "core/vec.h"
+#include "features/saliency.h"
+#include "sampling/volume_sampling.h"
 
 namespace raysift::sampling {
 
@@ -49,5 +55,64 @@ bool is_frame_pattern(const std::string& pattern);
 /// The file name of frame `index`: `pattern` formatted with it.
 /// \throw InvalidInput unless is_frame_pattern(pattern).
 std::string frame_file_name(const std::string& pattern, int index);
+
+/// The previous frame as the next one needs it for the saliency warp.
+struct PreviousFrame {
+  CameraSpec camera;
+  ImageRGBA image;  ///< composited over the background (what the user saw)
+  ImageF depth;     ///< ray depth (opacity 0.5) at traced pixels, +inf elsewhere (sparse)
+};
+
+/// How the importance of a path frame is built.
+struct PathFeatureOptions {
+  FeatureOptions lines;                ///< line classes (may be none)
+  bool use_saliency = false;           ///< --features saliency: max with the warped previous-frame saliency
+  features::SaliencyOptions saliency;
+};
+
+/// \brief Importance of a frame: frame_importance() (lines; -1 on background), then, only when
+/// `options.use_saliency` and `previous` is given, the per-pixel max with the previous frame's
+/// saliency warped to this camera (holes closed within the pattern's base spacing, disocclusions 0.5),
+/// on object pixels only. With saliency off this is frame_importance() itself and no saliency code runs.
+/// \param saliency_ms if non-null, receives the time of saliency + warp (0 when it did not run)
+ImageF path_frame_importance(const volume::RayCaster& caster, const FeatureGeometry* geometry,
+                             const PathFeatureOptions& options, const PreviousFrame* previous, int base_spacing,
+                             double* saliency_ms = nullptr);
+
+struct PathRenderOptions {
+  SamplingOptions sampling;     ///< mode and its parameters, used for every frame
+  PathFeatureOptions features;
+  double target_fps = 0;        ///< > 0: adapt α00 to hold this rate (prioritized mode); 0 = off
+  bool compare_full = false;    ///< also render each frame fully and report its SSIM (not timed)
+};
+
+/// One rendered frame of a path.
+struct PathFrame {
+  int index = 0;
+  double ms = 0;                ///< wall time: importance (+ saliency), priorities, trace, reconstruction
+  double saliency_ms = 0;
+  std::size_t rays_traced = 0;
+  std::size_t full_rays = 0;    ///< rays of the full render of this view
+  float alpha00 = 0;            ///< α00 used (target-fps: the controller's choice)
+  bool refined = false;         ///< same camera as before: previous rays kept, refinement continued
+  double ssim_vs_full = std::numeric_limits<double>::quiet_NaN();  ///< when compare_full
+};
+
+/// Receives each frame as soon as it is done (e.g. to write it).
+using PathFrameSink = std::function<void(const PathFrame& frame, const ImageRGBA& image)>;
+
+/// \brief Renders `cameras` in order with `render` options, handing every frame to `sink`.
+/// \param geometry line geometry (may be null: no lines)
+/// \throw InvalidInput for an empty path, invalid options, target_fps < 0 or target_fps > 0 with a mode
+///        other than prioritized.
+std::vector<PathFrame> render_camera_path(const volume::Volume& volume, const volume::TransferFunction& tf,
+                                          const volume::RenderOptions& render, const std::vector<CameraSpec>& cameras,
+                                          const FeatureGeometry* geometry, const PathRenderOptions& options,
+                                          const PathFrameSink& sink);
+
+/// The stats of a path: {"frames": [{"index", "ms", "rays_traced", "full_rays", "alpha00", "refined",
+/// "saliency_ms", "ssim_vs_full" (null without compare)}], "target_ms" (when set), "within_10pct_of_target"
+/// (share of frames with ms <= 1.1 target), "mean_ssim_vs_full" (when compared)}.
+Json path_stats_json(const std::vector<PathFrame>& frames, double target_fps);
 
 }  // namespace raysift::sampling

@@ -7,6 +7,8 @@
 #include <limits>
 
 #include "core/errors.h"
+#include "volume/generate.h"
+#include "volume/raycaster.h"
 
 namespace raysift::sampling {
 namespace {
@@ -88,6 +90,120 @@ TEST(CameraPath, FrameFileNames) {
     EXPECT_FALSE(is_frame_pattern(bad)) << bad;
     EXPECT_THROW(frame_file_name(bad, 1), InvalidInput) << bad;
   }
+}
+
+/// A 32^3 blobby volume seen from a camera 60 voxels away: small enough to render many frames fast.
+struct PathScene {
+  volume::Volume vol;
+  volume::TransferFunction tf{{{0.0, 0, 0, 0, 0}, {0.2, 0.9f, 0.5f, 0.2f, 0.05f}, {1.0, 1.0f, 1.0f, 0.8f, 0.6f}}};
+
+  PathScene() {
+    volume::BlobsOptions blobs;
+    blobs.grid.dims = {32, 32, 32};
+    blobs.count = 6;
+    blobs.sigma_voxels = 3;
+    vol = volume::make_blobs(blobs);
+  }
+  CameraSpec camera(double angle_deg) const {
+    OrbitSpec o;
+    o.centre = {15.5, 15.5, 15.5};
+    o.radius = 60;
+    o.elevation_deg = 20;
+    o.frames = 1;
+    o.start_deg = angle_deg;
+    o.width = o.height = 48;
+    return orbit_cameras(o)[0];
+  }
+};
+
+TEST(PathImportance, SaliencyOffIsTheLineImportanceBitForBitAndRunsNoSaliency) {
+  const PathScene scene;
+  const volume::RayCaster prev_caster(scene.vol, scene.tf, scene.camera(0));
+  const volume::RayCaster caster(scene.vol, scene.tf, scene.camera(6));
+  const volume::RenderResult prev = volume::render_full(prev_caster);
+  const PreviousFrame previous{scene.camera(0), prev.image, prev.depth};
+  PathFeatureOptions off;
+  double saliency_ms = -1;
+  const ImageF line_only = frame_importance(caster, nullptr, off.lines);
+  EXPECT_EQ(path_frame_importance(caster, nullptr, off, &previous, 8, &saliency_ms).pixels, line_only.pixels);
+  EXPECT_EQ(saliency_ms, 0.0);
+
+  PathFeatureOptions on = off;
+  on.use_saliency = true;
+  on.saliency.scale = 0.5;  // a 24 px map; 1/4 would be below the 16 px minimum
+  const ImageF with = path_frame_importance(caster, nullptr, on, &previous, 8, &saliency_ms);
+  EXPECT_GT(saliency_ms, 0.0);
+  bool raised = false;
+  for (std::size_t i = 0; i < with.size(); ++i) {
+    if (line_only.pixels[i] < 0) {
+      ASSERT_EQ(with.pixels[i], line_only.pixels[i]) << "background must stay background";
+    } else {
+      ASSERT_GE(with.pixels[i], line_only.pixels[i]);
+      ASSERT_LE(with.pixels[i], 1.f);
+      raised |= with.pixels[i] > line_only.pixels[i];
+    }
+  }
+  EXPECT_TRUE(raised);
+  // No previous frame (the first frame of a path): nothing to warp.
+  EXPECT_EQ(path_frame_importance(caster, nullptr, on, nullptr, 8, &saliency_ms).pixels, line_only.pixels);
+}
+
+TEST(RenderCameraPath, StillCameraReusesRaysAndConvergesToTheFullRender) {
+  const PathScene scene;
+  const std::vector<CameraSpec> cams(6, scene.camera(10));
+  PathRenderOptions opt;
+  opt.sampling.mode = SamplingMode::Prioritized;
+  opt.sampling.ray_fraction = 0.1;
+  std::vector<ImageRGBA> images;
+  const auto frames = render_camera_path(scene.vol, scene.tf, {}, cams, nullptr, opt,
+                                         [&](const PathFrame&, const ImageRGBA& img) { images.push_back(img); });
+  ASSERT_EQ(frames.size(), 6u);
+  std::size_t total = 0;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    EXPECT_EQ(frames[i].refined, i > 0);
+    if (i > 1) {
+      EXPECT_GT(frames[i].alpha00, frames[i - 1].alpha00);
+    }
+    total += frames[i].rays_traced;
+  }
+  // Every object ray is traced exactly once over the path, and the last frame is the full render.
+  EXPECT_EQ(total, frames.back().full_rays);
+  const volume::RayCaster caster(scene.vol, scene.tf, cams.back());
+  EXPECT_EQ(images.back().pixels, volume::render_full(caster).image.pixels);
+  EXPECT_LT(frames[0].rays_traced, frames[0].full_rays / 5);
+}
+
+TEST(RenderCameraPath, FullModeOnAnOrbitMatchesSingleRenders) {
+  const PathScene scene;
+  const std::vector<CameraSpec> cams{scene.camera(0), scene.camera(30), scene.camera(60)};
+  PathRenderOptions opt;
+  opt.sampling.mode = SamplingMode::Full;
+  opt.compare_full = true;
+  std::vector<ImageRGBA> images;
+  const auto frames = render_camera_path(scene.vol, scene.tf, {}, cams, nullptr, opt,
+                                         [&](const PathFrame&, const ImageRGBA& img) { images.push_back(img); });
+  for (std::size_t i = 0; i < cams.size(); ++i) {
+    const volume::RayCaster caster(scene.vol, scene.tf, cams[i]);
+    EXPECT_EQ(images[i].pixels, volume::render_full(caster).image.pixels);
+    EXPECT_EQ(frames[i].ssim_vs_full, 1.0);
+    EXPECT_EQ(frames[i].rays_traced, 48u * 48u);
+  }
+  const Json stats = path_stats_json(frames, 0);
+  EXPECT_EQ(stats.at("frames").size(), 3u);
+  EXPECT_EQ(stats.at("mean_ssim_vs_full"), 1.0);
+}
+
+TEST(RenderCameraPath, RejectsBadRequests) {
+  const PathScene scene;
+  const auto sink = [](const PathFrame&, const ImageRGBA&) {};
+  PathRenderOptions opt;
+  EXPECT_THROW(render_camera_path(scene.vol, scene.tf, {}, {}, nullptr, opt, sink), InvalidInput);
+  opt.target_fps = 10;
+  opt.sampling.mode = SamplingMode::Full;
+  EXPECT_THROW(render_camera_path(scene.vol, scene.tf, {}, {scene.camera(0)}, nullptr, opt, sink), InvalidInput);
+  opt.sampling.mode = SamplingMode::Prioritized;
+  opt.target_fps = -1;
+  EXPECT_THROW(render_camera_path(scene.vol, scene.tf, {}, {scene.camera(0)}, nullptr, opt, sink), InvalidInput);
 }
 
 }  // namespace
