@@ -14,6 +14,7 @@
 #include "core/progress.h"
 #include "core/scene.h"
 #include "core/timer.h"
+#include "sampling/volume_sampling.h"
 #include "volume/raycaster.h"
 #include "volume/transfer_function.h"
 #include "volume/vdb_io.h"
@@ -28,9 +29,17 @@ struct RenderCliOptions {
   double step = volume::RenderOptions{}.step_voxels;
   std::string shading = "none";
   std::string background = "0,0,0";
+  std::string light_dir;  ///< "" = headlight
   double early_termination = volume::RenderOptions{}.early_termination;
   bool no_skip = false, jitter = false, tf_normalized = false;
   std::string pixel;  ///< "x,y": trace one pixel serially and print it
+  // Sampled modes (prioritized, subsample): sampling/volume_sampling.h.
+  double ray_fraction = sampling::SamplingOptions{}.ray_fraction;
+  double budget_ms = 0;
+  std::string features = "contours,silhouettes";
+  std::string alpha;            ///< "a00,a10,a01,a11,a20,a02"; empty = library default
+  int progressive = 0;
+  std::string feature_mesh;
 };
 
 /// Everything a mode needs, built once from flags and scene.
@@ -39,6 +48,7 @@ struct RenderInputs {
   std::unique_ptr<volume::TransferFunction> tf;
   CameraSpec camera;
   volume::RenderOptions options;
+  sampling::SampledRenderRequest sampled;  ///< used by the prioritized and subsample modes
 };
 
 /// What a mode returns: the final image (composited, alpha = accumulated opacity) and its counts.
@@ -51,6 +61,16 @@ struct ModeOutput {
 
 using ModeFunction = std::function<ModeOutput(const RenderInputs&, const volume::RayCaster&, const CommonOptions&)>;
 
+// Prioritized and subsample rendering (sampling/volume_sampling.h); the request was built from the flags.
+ModeOutput sampled_mode(const RenderInputs& in, const volume::RayCaster& caster, const CommonOptions& common) {
+  sampling::SampledRender r = sampling::render_sampled_volume(in.volume, *in.tf, caster, in.sampled);
+  if (r.budget_too_small && !common.quiet)
+    std::cerr << "raysift: warning: --budget-ms " << in.sampled.sampling.budget_ms
+              << " is below the time of the level-0 pattern plus reconstruction; only level 0 was traced\n";
+  const auto rays = r.stats["rays_traced"].get<std::uint64_t>();
+  return ModeOutput{std::move(r.image), rays, 0, std::move(r.stats)};
+}
+
 const std::map<std::string, ModeFunction>& modes() {
   static const std::map<std::string, ModeFunction> table = {
       {"full",
@@ -59,6 +79,8 @@ const std::map<std::string, ModeFunction>& modes() {
          volume::RenderResult r = volume::render_full(caster, [&bar](double f) { bar.update(f); });
          return ModeOutput{std::move(r.image), r.rays_traced, r.samples, Json::object()};
        }},
+      {"prioritized", sampled_mode},
+      {"subsample", sampled_mode},
   };
   return table;
 }
@@ -69,21 +91,35 @@ std::string mode_names() {
   return names;
 }
 
-Vec3f parse_background(const std::string& text) {
+/// "a,b,c" -> three numbers (NaN for any malformed item, which every range check rejects).
+std::vector<double> parse_triple(const std::string& text) {
   std::stringstream s(text);
   std::string item;
-  std::vector<float> v;
+  std::vector<double> v;
   while (std::getline(s, item, ',')) {
     try {
       std::size_t used = 0;
-      v.push_back(std::stof(item, &used));
-      if (used != item.size()) v.push_back(NAN);
+      v.push_back(std::stod(item, &used));
+      if (used != item.size()) v.back() = NAN;
     } catch (const std::exception&) {
       v.push_back(NAN);
     }
   }
-  if (v.size() != 3 || !std::all_of(v.begin(), v.end(), [](float c) { return c >= 0.0f && c <= 1.0f; }))
+  return v;
+}
+
+Vec3f parse_background(const std::string& text) {
+  const std::vector<double> v = parse_triple(text);
+  if (v.size() != 3 || !std::all_of(v.begin(), v.end(), [](double c) { return c >= 0.0 && c <= 1.0; }))
     bad_flag("--background", "three comma-separated linear values in [0,1] (R,G,B)", text);
+  return {float(v[0]), float(v[1]), float(v[2])};
+}
+
+Vec3d parse_light_dir(const std::string& text) {
+  const std::vector<double> v = parse_triple(text);
+  if (v.size() != 3 || !std::all_of(v.begin(), v.end(), [](double c) { return std::isfinite(c); }) ||
+      v[0] * v[0] + v[1] * v[1] + v[2] * v[2] == 0.0)
+    bad_flag("--light-dir", "three comma-separated finite numbers, not all zero (X,Y,Z)", text);
   return {v[0], v[1], v[2]};
 }
 
@@ -105,6 +141,11 @@ void validate(const RenderCliOptions& o) {
   if (o.shading != "none" && o.shading != "phong") bad_flag("--shading", "none|phong", o.shading);
   const std::string ext = file_extension(o.out);
   if (ext != ".exr" && ext != ".png") bad_flag("-o/--out", "a .exr or .png path", o.out);
+  if (!(o.ray_fraction > 0 && o.ray_fraction <= 1)) bad_flag("--ray-fraction", "in (0, 1]", num(o.ray_fraction));
+  if (!(o.budget_ms >= 0) || !std::isfinite(o.budget_ms)) bad_flag("--budget-ms", ">= 0 (0 = no budget)", num(o.budget_ms));
+  if (o.progressive < 0) bad_flag("--progressive", ">= 0 frames", std::to_string(o.progressive));
+  if ((o.budget_ms > 0 || o.progressive > 0) && o.mode != "prioritized")
+    throw UsageError("--budget-ms and --progressive need --mode prioritized; see --help");
 }
 
 RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common) {
@@ -155,10 +196,27 @@ RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common
   in.options.step_voxels = o.step;
   in.options.shading = o.shading == "phong" ? volume::Shading::Phong : volume::Shading::None;
   in.options.background = parse_background(o.background);
+  if (!o.light_dir.empty()) {
+    in.options.phong.headlight = false;
+    in.options.phong.light_dir_ws = parse_light_dir(o.light_dir);
+  }
   in.options.early_termination = o.early_termination;
   in.options.skip_empty_space = !o.no_skip;
   in.options.jitter = o.jitter;
   in.options.seed = common.seed;
+
+  in.sampled.sampling.mode = sampling::parse_sampling_mode(o.mode);
+  in.sampled.sampling.ray_fraction = o.ray_fraction;
+  in.sampled.sampling.budget_ms = o.budget_ms;
+  in.sampled.sampling.seed = common.seed;
+  in.sampled.progressive_frames = o.progressive;
+  in.sampled.feature_mesh = o.feature_mesh;
+  try {
+    if (!o.alpha.empty()) in.sampled.sampling.mapping = sampling::parse_priority_mapping(o.alpha);
+    in.sampled.features.classes = sampling::parse_feature_list(o.features);
+  } catch (const InvalidInput& e) {
+    throw UsageError(std::string(e.what()) + "; see --help");
+  }
   return in;
 }
 
@@ -169,7 +227,7 @@ std::string echo_command(const RenderCliOptions& o, const RenderInputs& in, cons
   if (!o.tf.empty()) s << " --tf " << o.tf;
   if (!o.camera.empty()) s << " --camera " << o.camera;
   s << " --width " << in.camera.width << " --height " << in.camera.height << " --mode " << o.mode << " --step "
-    << o.step << " --shading " << o.shading << " --background " << o.background << " --early-termination "
+    << o.step << " --shading " << o.shading << (o.light_dir.empty() ? "" : " --light-dir " + o.light_dir) << " --background " << o.background << " --early-termination "
     << o.early_termination << (o.no_skip ? " --no-skip" : "") << (o.jitter ? " --jitter" : "") << " --seed "
     << common.seed << " --threads " << common.threads << " -o " << o.out;
   return s.str();
@@ -204,17 +262,36 @@ RegisterCommand reg(
       sub.add_option("--mode", opt->mode, "render mode: " + mode_names())->capture_default_str();
       sub.add_option("--step", opt->step, "sample distance in voxels, (0, 64]")->capture_default_str();
       sub.add_option("--shading", opt->shading, "none|phong (Blinn-Phong, headlight)")->capture_default_str();
+      sub.add_option("--light-dir", opt->light_dir,
+                     "Phong: directional light travelling along X,Y,Z (world); default: headlight");
       sub.add_option("--background", opt->background, "background R,G,B (linear, 0..1)")->capture_default_str();
       sub.add_option("--early-termination", opt->early_termination, "stop a ray at this opacity; 1 disables")
           ->capture_default_str();
       sub.add_flag("--no-skip", opt->no_skip, "disable empty-space skipping (same image, slower)");
       sub.add_flag("--jitter", opt->jitter, "random start offset per ray (from --seed)");
       sub.add_option("--pixel", opt->pixel, "debug: trace only pixel x,y serially and print it (no image written)");
+      sub.add_option("--ray-fraction", opt->ray_fraction,
+                     "prioritized/subsample: rays as a fraction of the full render's, (0, 1]")
+          ->capture_default_str();
+      sub.add_option("--budget-ms", opt->budget_ms, "prioritized: frame time budget in ms (0 = use --ray-fraction)")
+          ->capture_default_str();
+      sub.add_option("--features", opt->features,
+                     "prioritized: line classes for the importance (contours,silhouettes,suggestive,highlights,"
+                     "ridges,valleys|all) or none (pattern-only control)")
+          ->capture_default_str();
+      sub.add_option("--alpha", opt->alpha, "prioritized: priority mapping a00,a10,a01,a11,a20,a02 (default 0.5,0.1,0.5,0.1,0,0)");
+      sub.add_option("--progressive", opt->progressive,
+                     "prioritized: render N progressive frames of a still camera, write the last")
+          ->capture_default_str();
+      sub.add_option("--feature-mesh", opt->feature_mesh,
+                     "prioritized: prepared feature mesh (e.g. from raysift mesh) instead of extracting iso-surfaces");
       sub.footer(
           "Examples:\n"
           "  raysift render datasets/engine_ct.vdb --tf datasets/engine_ct_tf.json -o engine.png\n"
           "  raysift render --scene datasets/engine_ct_scene.json --shading phong --width 1440 --height 900 "
-          "-o engine.exr --stats stats.json");
+          "-o engine.exr --stats stats.json\n"
+          "  raysift render --scene datasets/engine_ct_scene.json --mode prioritized --ray-fraction 0.2 -o p.exr\n"
+          "  raysift render --scene datasets/engine_ct_scene.json --mode subsample --ray-fraction 0.2 -o s.exr");
       return [opt, &common] {
         const Timer total;
         validate(*opt);
@@ -245,7 +322,7 @@ RegisterCommand reg(
                       {"skip_empty_space", in.options.skip_empty_space},
                       {"visible_blocks", caster.visible_block_count()},
                       {"times_ms", {{"setup", setup_ms}, {"trace", trace_ms}, {"total", total_ms}}}};
-        stats.update(result.extra_stats);
+        stats.merge_patch(result.extra_stats);  // keeps times_ms.setup next to the sampled modes' stage times
         write_stats_if_requested(common, stats);
       };
     });

@@ -208,6 +208,14 @@ TEST(RayCaster, PhongHeadlightOnBall) {
   // Towards the rim the normal tilts away from the light, so the pixel gets darker.
   EXPECT_LT(caster.trace(32 + 18, 32).color.r, caster.trace(32 + 9, 32).color.r);
   EXPECT_LT(caster.trace(32 + 9, 32).color.r, caster.trace(32, 32).color.r);
+
+  // A directional light along the view axis lights the centre like the headlight; one at 90° leaves
+  // the ambient term 0.5·k_a = 0.1 plus a highlight of k_s·cos(45°)^20 ≈ 3e-4.
+  o.phong.headlight = false;
+  o.phong.light_dir_ws = {0, 0, -1};
+  EXPECT_NEAR(RayCaster(vol, step_tf(1.0f, 0.5f), ball_camera(65, 65), o).trace(32, 32).color.r, 0.75f, 0.01f);
+  o.phong.light_dir_ws = {1, 0, 0};
+  EXPECT_NEAR(RayCaster(vol, step_tf(1.0f, 0.5f), ball_camera(65, 65), o).trace(32, 32).color.r, 0.1f, 0.01f);
 }
 
 TEST(RayCaster, BackgroundPixelsAndTracePixelsAgreeWithTrace) {
