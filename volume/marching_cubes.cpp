@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/errors.h"
 #include "volume/detail/mc_tables.h"
@@ -119,11 +120,18 @@ void gather(const Accessor& acc, const openvdb::Coord& origin, float background,
       const float* data = leaf->buffer().data();
       const auto& mask = leaf->getValueMask();
       for (int x = x0; x < x1; ++x)
-        for (int y = y0; y < y1; ++y)
-          for (int z = z0; z < z1; ++z) {
-            const openvdb::Index n = openvdb::Index((x - x0) << 6 | (y - y0) << 3 | (z - z0));
-            values[region_index(x, y, z)] = mask.isOn(n) ? data[n] : background;
+        for (int y = y0; y < y1; ++y) {
+          // The 8 active bits of leaf row (x, y) are one byte of mask word x.
+          const int lx = x - x0, ly = y - y0;
+          const unsigned row_mask = unsigned(mask.getWord<std::uint64_t>(lx) >> (8 * ly)) & 0xFFu;
+          const float* src = data + (lx << 6 | ly << 3);
+          float* dst = values + region_index(x, y, 0);
+          if (row_mask == 0xFFu && z0 == 0 && z1 == kB) {
+            std::copy(src, src + kB, dst);
+            continue;
           }
+          for (int z = z0; z < z1; ++z) dst[z] = (row_mask >> (z - z0)) & 1u ? src[z - z0] : background;
+        }
     } else {
       float tile = background;
       const float v = acc.probeValue(leaf_origin, tile) ? tile : background;
@@ -140,12 +148,16 @@ void process_block(const Accessor& acc, const openvdb::math::Transform& xform, c
                    float background, double iso, BlockOutput& out) {
   float values[kRegion];
   gather(acc, origin, background, values);
+  // For a float v, v >= iso (double) exactly when v >= iso_f, the smallest float not below iso; comparing
+  // floats keeps the loop vectorisable.
+  float iso_f = float(iso);
+  if (double(iso_f) < iso) iso_f = std::nextafter(iso_f, std::numeric_limits<float>::infinity());
   // rows[x * kR + y]: bit z set when sample (x, y, z) is inside (value >= iso; NaN is outside).
   std::uint32_t rows[kR * kR];
   bool any_inside = false, any_outside = false;
   for (int r = 0; r < kR * kR; ++r) {
     std::uint32_t bits = 0;
-    for (int z = 0; z < kR; ++z) bits |= std::uint32_t(values[r * kR + z] >= iso) << z;
+    for (int z = 0; z < kR; ++z) bits |= std::uint32_t(values[r * kR + z] >= iso_f) << z;
     rows[r] = bits;
     any_inside |= bits != 0;
     any_outside |= bits != kFullRow;
