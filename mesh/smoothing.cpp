@@ -112,7 +112,9 @@ TriMesh taubin_smooth(const TriMesh& mesh, const SmoothingOptions& options) {
         Vec3d sum;
         double weight = 0;
         if (uniform) {
-          for (std::uint32_t i = b; i < e; ++i) sum += Vec3d(current[adj.items[i]]);
+          Vec3f sum_f;  // a handful of neighbours: float accumulation is exact enough and cheaper
+          for (std::uint32_t i = b; i < e; ++i) sum_f += current[adj.items[i]];
+          sum = Vec3d(sum_f);
           weight = double(e - b);
         } else {
           for (std::uint32_t i = b; i < e; ++i) {
