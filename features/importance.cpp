@@ -1,5 +1,6 @@
 #include "features/importance.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
 
@@ -49,7 +50,19 @@ void for_pixels(int width, int height, bool threaded, const F& f) {
   }
 }
 
-/// Slab test: does the ray hit the box at some t >= 0 (a camera inside the box always hits)?
+template <typename F>
+void for_rows(int height, bool threaded, const F& f) {
+  if (threaded) {
+    tbb::parallel_for(tbb::blocked_range<int>(0, height, 8), [&](const tbb::blocked_range<int>& r) {
+      for (int y = r.begin(); y != r.end(); ++y) f(y);
+    });
+  } else {
+    for (int y = 0; y < height; ++y) f(y);
+  }
+}
+
+/// Slab test: does the ray hit the box at some t >= 0 (a camera inside the box always hits)? The direction
+/// need not have unit length.
 bool ray_hits_box(const Ray& ray, const Bbox3d& box) {
   double t0 = 0, t1 = std::numeric_limits<double>::infinity();
   for (int a = 0; a < 3; ++a) {
@@ -73,8 +86,22 @@ Image<std::uint8_t> coverage(const Camera& camera, const BackgroundGeometry& bg,
                              bool threaded) {
   const int w = camera.width(), h = camera.height();
   Image<std::uint8_t> hit(w, h, 0);
-  if (bg.bbox_ws)
-    for_pixels(w, h, threaded, [&](int x, int y) { hit(x, y) = ray_hits_box(camera.ray(x + 0.5, y + 0.5), *bg.bbox_ws); });
+  if (bg.bbox_ws) {
+    // The rays that hit a box form a convex cone (all rays when the eye is inside), so on every image row
+    // they are one run of pixels: find its two ends and fill between. The slab test needs no unit
+    // direction, so the unnormalised pixel direction saves a square root.
+    auto hits_box = [&](int x, int y) {
+      return ray_hits_box({camera.eye(), camera.direction_unit_depth(x + 0.5, y + 0.5)}, *bg.bbox_ws);
+    };
+    for_rows(h, threaded, [&](int y) {
+      int left = 0;
+      while (left < w && !hits_box(left, y)) ++left;
+      if (left == w) return;
+      int right = w - 1;
+      while (right > left && !hits_box(right, y)) --right;
+      std::fill(&hit(left, y), &hit(right, y) + 1, std::uint8_t(1));
+    });
+  }
   if (mesh_frame_depth) {
     const ImageF& d = mesh_frame_depth->depth;
     for_pixels(w, h, threaded, [&](int x, int y) {
@@ -118,14 +145,15 @@ ImportanceBuffer rasterize(const FeatureLines& visible, const Camera& frame, con
   std::sort(levels.begin(), levels.end());
   levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
   const double falloff = o.falloff_px * o.scale;
+  Image<std::uint8_t> seeds(w, h, 0);
   for (float level : levels) {
     std::vector<detail::Segment2> level_segs;
     for (const detail::Segment2& s : segs)
       if (o.priority[std::size_t(visible.segments[s.index].line_class)] == level) level_segs.push_back(s);
-    Image<std::uint8_t> seeds(w, h, 0);
+    std::fill(seeds.pixels.begin(), seeds.pixels.end(), std::uint8_t(0));
     detail::for_each_pixel_near_segments(w, h, level_segs, kLineCorePx, o.threaded,
                                          [&](int x, int y, double, const detail::Segment2&) { seeds(x, y) = 1; });
-    const ImageF d2 = detail::squared_distance_transform(seeds, o.threaded);
+    const ImageF d2 = detail::squared_distance_transform(seeds, 0.5 + falloff, o.threaded);
     const float reach2 = float((0.5 + falloff) * (0.5 + falloff));
     for_pixels(w, h, o.threaded, [&](int x, int y) {
       if (d2(x, y) >= reach2) return;  // beyond the fall-off: contributes 0

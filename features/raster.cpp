@@ -164,15 +164,25 @@ DepthBuffer rasterize_depth(const mesh::TriMesh& mesh, const Camera& camera, con
         eb[j] = (x[c] - x[a]) / area;
         ec[j] = -(ea[j] * x[a] + eb[j] * y[a]);
       }
+      // 1/z is affine on screen too: iz(x, y) = ia·x + ib·y + ic.
+      const double ia = ea[0] * st.inv_z[0] + ea[1] * st.inv_z[1] + ea[2] * st.inv_z[2];
+      const double ib = eb[0] * st.inv_z[0] + eb[1] * st.inv_z[1] + eb[2] * st.inv_z[2];
+      const double ic = ec[0] * st.inv_z[0] + ec[1] * st.inv_z[1] + ec[2] * st.inv_z[2];
       for (int r = std::max(st.r0, band_r0); r <= std::min(st.r1, band_r1); ++r) {
         const double py = r + 0.5;
-        for (int col = st.c0; col <= st.c1; ++col) {
-          const double px = col + 0.5;
-          const double b0 = ea[0] * px + eb[0] * py + ec[0];
-          const double b1 = ea[1] * px + eb[1] * py + ec[1];
-          const double b2 = ea[2] * px + eb[2] * py + ec[2];
-          if (b0 < 0 || b1 < 0 || b2 < 0) continue;
-          const float z = float(1.0 / (b0 * double(st.inv_z[0]) + b1 * double(st.inv_z[1]) + b2 * double(st.inv_z[2])));
+        // The covered columns of this row form one span: each edge bounds px = col + 0.5 from one side.
+        int lo = st.c0, hi = st.c1;
+        for (int j = 0; j < 3 && lo <= hi; ++j) {
+          const double k = eb[j] * py + ec[j];  // b_j = ea[j]·px + k >= 0
+          if (ea[j] > 0)
+            lo = std::max(lo, int(std::ceil(-k / ea[j] - 0.5)));
+          else if (ea[j] < 0)
+            hi = std::min(hi, int(std::floor(-k / ea[j] - 0.5)));
+          else if (k < 0)
+            hi = lo - 1;
+        }
+        for (int col = lo; col <= hi; ++col) {
+          const float z = float(1.0 / (ia * (col + 0.5) + ib * py + ic));
           float& cur = out.depth(col, r);
           std::uint32_t& cur_face = out.face(col, r);
           if (z < cur || (z == cur && st.face < cur_face)) {

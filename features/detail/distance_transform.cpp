@@ -3,6 +3,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
 #include <vector>
 
@@ -54,24 +56,40 @@ void for_lines(int n, bool threaded, const F& body) {
 
 }  // namespace
 
-ImageF squared_distance_transform(const Image<std::uint8_t>& seeds, bool threaded) {
+ImageF squared_distance_transform(const Image<std::uint8_t>& seeds, double max_distance, bool threaded) {
   const int w = seeds.width, h = seeds.height;
-  std::vector<double> cols(std::size_t(w) * std::size_t(h));
-  for_lines(w, threaded, [&](int x) {
-    const auto n = static_cast<std::size_t>(h);
+  ImageF out(w, h, std::numeric_limits<float>::infinity());
+  int x0 = w, x1 = -1, y0 = h, y1 = -1;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      if (seeds(x, y)) {
+        x0 = std::min(x0, x);
+        x1 = std::max(x1, x);
+        y0 = std::min(y0, y);
+        y1 = std::max(y1, y);
+      }
+  if (x1 < 0) return out;
+  const int pad = int(std::ceil(std::max(0.0, max_distance)));
+  x0 = std::max(0, x0 - pad);
+  x1 = std::min(w - 1, x1 + pad);
+  y0 = std::max(0, y0 - pad);
+  y1 = std::min(h - 1, y1 + pad);
+  const int bw = x1 - x0 + 1, bh = y1 - y0 + 1;
+  std::vector<double> cols(std::size_t(bw) * std::size_t(bh));
+  for_lines(bw, threaded, [&](int i) {
+    const auto n = static_cast<std::size_t>(bh);
     std::vector<double> f(n), d(n), z(n + 1);
     std::vector<int> v(n);
-    for (int y = 0; y < h; ++y) f[std::size_t(y)] = seeds(x, y) ? 0.0 : kInf;
-    envelope_1d(f.data(), h, d.data(), v, z);
-    for (int y = 0; y < h; ++y) cols[std::size_t(y) * std::size_t(w) + std::size_t(x)] = d[std::size_t(y)];
+    for (int j = 0; j < bh; ++j) f[std::size_t(j)] = seeds(x0 + i, y0 + j) ? 0.0 : kInf;
+    envelope_1d(f.data(), bh, d.data(), v, z);
+    for (int j = 0; j < bh; ++j) cols[std::size_t(j) * std::size_t(bw) + std::size_t(i)] = d[std::size_t(j)];
   });
-  ImageF out(w, h);
-  for_lines(h, threaded, [&](int y) {
-    const auto n = static_cast<std::size_t>(w);
+  for_lines(bh, threaded, [&](int j) {
+    const auto n = static_cast<std::size_t>(bw);
     std::vector<double> d(n), z(n + 1);
     std::vector<int> v(n);
-    envelope_1d(cols.data() + std::size_t(y) * std::size_t(w), w, d.data(), v, z);
-    for (int x = 0; x < w; ++x) out(x, y) = float(d[std::size_t(x)]);
+    envelope_1d(cols.data() + std::size_t(j) * n, bw, d.data(), v, z);
+    for (int i = 0; i < bw; ++i) out(x0 + i, y0 + j) = float(d[std::size_t(i)]);
   });
   return out;
 }

@@ -8,8 +8,10 @@
 
 namespace raysift::features::detail {
 
-/// Squared distance (pixels²) from each pixel centre to the nearest seed pixel centre (seed != 0);
-/// +inf everywhere when there is no seed. Identical for any thread count.
-ImageF squared_distance_transform(const Image<std::uint8_t>& seeds, bool threaded);
+/// Squared distance (pixels²) from each pixel centre to the nearest seed pixel centre (seed != 0), exact
+/// for every pixel within `max_distance` of a seed; farther pixels may hold +inf instead (the transform
+/// only runs over the seeds' bounding box grown by max_distance). +inf everywhere when there is no seed.
+/// Identical for any thread count.
+ImageF squared_distance_transform(const Image<std::uint8_t>& seeds, double max_distance, bool threaded);
 
 }  // namespace raysift::features::detail
