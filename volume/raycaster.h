@@ -102,8 +102,9 @@ class RayCaster {
   RaySample trace(int x, int y) const;
   /// out[i] = trace(pixel_indices[i] % width, pixel_indices[i] / width). \pre same sizes, valid indices.
   void trace_pixels(Span<const std::uint32_t> pixel_indices, Span<RaySample> out) const;
-  /// True if the pixel's ray misses the bounding box of all TF-visible blocks, i.e. trace() would
-  /// return transparent black with zero samples (cheap: a ray-box test).
+  /// True if the pixel's ray misses the bounding box of all TF-visible blocks, i.e. trace() returns
+  /// transparent black (with zero samples when skipping is on). Cheap: one ray-box test. False does
+  /// not promise a hit: the ray may pass between visible blocks.
   bool pixel_is_background(int x, int y) const;
 
   /// Number of 8³ blocks with a non-zero opacity somewhere in their value range (diagnostics).
