@@ -41,15 +41,6 @@ struct Config {
   int shadow_map = 1024;   ///< shadow-map resolution (fixed while the depth-image resolution varies)
 };
 
-// A square light of diagonal size * scene diagonal, half a diagonal above the top of the box, facing down.
-nrr::AreaLight light_above(const Bbox3d& b, const Vec3d& up, double size) {
-  const Vec3d u = nrr::any_perpendicular(up);
-  const Vec3d v = cross(u, up);  // u x v = u x (u x up) = -up: the light emits down
-  const double side = size * b.diagonal() / std::sqrt(2.0);
-  const double top = dot(b.max - b.center(), Vec3d{std::abs(up.x), std::abs(up.y), std::abs(up.z)});
-  return nrr::AreaLight{b.center() + up * (top + 0.5 * b.diagonal()), u * side, v * side};
-}
-
 BenchScene generated(const std::string& name, std::size_t triangles = 0) {
   nrr::SceneOptions o;
   o.triangles = triangles;
@@ -97,7 +88,8 @@ void error_table(const BenchScene& s, const Config& cfg, bool vary_resolution) {
   const nrr::Receivers rec = nrr::trace_receivers(sampled.rays(), Camera(cam));
   const Bbox3d bounds = sampled.rays().bounds();
   std::printf("\n%s (%zu triangles), errors vs the shadowmap reference, %s\n", s.name.c_str(), s.mesh.triangle_count(),
-              vary_resolution ? "light size 1, vs depth-image resolution" : "resolution 1024, vs light size");
+              vary_resolution ? "light size 1, vs depth-image resolution"
+                              : (cfg.quick ? "depth images 512, vs light size" : "depth images 1024, vs light size"));
   std::printf("%-8s | %-15s | %-15s | %-15s | %-15s | %s\n", vary_resolution ? "res" : "size", "nrr i / v",
               "conv i / v", "peel i / v", "SM-vs-RT i / v", "nrr/conv i");
   const std::vector<double> values = vary_resolution ? std::vector<double>{512, 1024, 1536}
@@ -108,12 +100,12 @@ void error_table(const BenchScene& s, const Config& cfg, bool vary_resolution) {
     o.shadow_map_resolution = cfg.shadow_map;
     o.depth_image_resolution = vary_resolution ? int(value) : 1024;
     if (cfg.quick) o.depth_image_resolution /= 2;
-    const nrr::AreaLight light = light_above(bounds, s.up, vary_resolution ? 1.0 : value);
+    const nrr::AreaLight light = nrr::light_above_box(bounds, s.up, vary_resolution ? 1.0 : value);
     const nrr::ShadowResult ref = nrr::render_shadows(s.mesh, sampled, rec, light, nrr::ShadowMethod::ShadowMap, o);
     const nrr::ShadowResult exact = nrr::render_shadows(s.mesh, sampled, rec, light, nrr::ShadowMethod::Raytrace, o);
     const nrr::ShadowErrors floor =
         nrr::compute_shadow_errors(ref.visibility, exact.visibility, Span<const std::uint8_t>(rec.is_hit));
-    std::printf("%-8g |", value);
+    std::printf("%-8g |", vary_resolution ? double(o.depth_image_resolution) : value);
     double ratio[2] = {0, 0};
     int k = 0;
     for (nrr::ShadowMethod m : kDiscretizations) {
@@ -138,7 +130,7 @@ void times_table(const std::vector<BenchScene>& scenes, const Config& cfg) {
     CameraSpec cam = s.camera;
     cam.width = cam.height = cfg.output;
     const nrr::Receivers rec = nrr::trace_receivers(sampled.rays(), Camera(cam));
-    const nrr::AreaLight light = light_above(sampled.rays().bounds(), s.up, 1.0);
+    const nrr::AreaLight light = nrr::light_above_box(sampled.rays().bounds(), s.up, 1.0);
     nrr::ShadowOptions o;
     o.light_samples_per_side = cfg.samples;
     o.shadow_map_resolution = cfg.shadow_map;
@@ -182,7 +174,7 @@ void scaling_table(const Config& cfg) {
       const nrr::ShadowMethod m = k == 0 ? nrr::ShadowMethod::Raytrace
                                  : k == 1 ? nrr::ShadowMethod::ShadowMap
                                           : nrr::ShadowMethod::Nrr;
-      nrr::render_shadows(s.mesh, sampled, rec, light_above(sampled.rays().bounds(), s.up, 1.0), m, o);
+      nrr::render_shadows(s.mesh, sampled, rec, nrr::light_above_box(sampled.rays().bounds(), s.up, 1.0), m, o);
       t[k] = timer.elapsed_ms();
     }
     std::printf("%-10zu %10.0f %12.0f %12.0f %16.0f\n", s.mesh.triangle_count(), t[0], t[1], t[2], t[3]);

@@ -70,4 +70,20 @@ std::vector<Vec3d> light_samples(const AreaLight& light, int n) {
   return samples;
 }
 
+AreaLight light_above_box(const Bbox3d& box, const Vec3d& up, double diagonal_rel, double height_rel) {
+  RAYSIFT_CHECK(!box.is_empty());
+  const Vec3d u = any_perpendicular(up);
+  const Vec3d v = cross(u, up);  // u x (u x up) = -up: the light emits down
+  const double side = diagonal_rel * box.diagonal() / std::sqrt(2.0);
+  // Distance from the centre to the top face along up (up need not be an axis).
+  const Vec3d half = box.extent() * 0.5;
+  const double top = half.x * std::abs(up.x) + half.y * std::abs(up.y) + half.z * std::abs(up.z);
+  return AreaLight{box.center() + up * (top + height_rel * box.diagonal()), u * side, v * side};
+}
+
+Vec3d any_perpendicular(const Vec3d& v) {
+  const Vec3d axis = std::abs(v.x) < 0.6 ? Vec3d{1, 0, 0} : (std::abs(v.y) < 0.6 ? Vec3d{0, 1, 0} : Vec3d{0, 0, 1});
+  return normalize(cross(v, axis));
+}
+
 }  // namespace raysift::nrr

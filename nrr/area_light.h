@@ -42,4 +42,12 @@ AreaLight rescale_light(const AreaLight& light, double diagonal);
 /// n = 1 gives the centre. \throw InvalidInput if n < 1 or n > 256.
 std::vector<Vec3d> light_samples(const AreaLight& light, int n);
 
+/// A square light of diagonal `diagonal_rel` x the box diagonal, centred over the box along `up` at
+/// `height_rel` box diagonals above the box's top, emitting toward -up (the benchmark and test setup;
+/// the NRR experiments use diagonal_rel = 1). \pre box not empty, up unit length.
+AreaLight light_above_box(const Bbox3d& box, const Vec3d& up, double diagonal_rel, double height_rel = 0.5);
+
+/// A unit vector perpendicular to v (zero for v = 0); used to complete view frames.
+Vec3d any_perpendicular(const Vec3d& v);
+
 }  // namespace raysift::nrr

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/errors.h"
+#include "nrr/area_light.h"
 
 namespace raysift::nrr {
 
@@ -26,11 +27,6 @@ inline bool owns_edge(double ax, double ay, double bx, double by) {
   return dy > 0.0 || (dy == 0.0 && dx < 0.0);
 }
 }  // namespace
-
-Vec3d any_perpendicular(const Vec3d& v) {
-  const Vec3d axis = std::abs(v.x) < 0.6 ? Vec3d{1, 0, 0} : (std::abs(v.y) < 0.6 ? Vec3d{0, 1, 0} : Vec3d{0, 0, 1});
-  return normalize(cross(v, axis));
-}
 
 ShadowFrustum fit_shadow_frustum(const Vec3d& eye_ws, Span<const Vec3d> points, const Vec3d& fallback_forward,
                                  int resolution, double z_near) {

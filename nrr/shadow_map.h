@@ -26,9 +26,6 @@ struct ShadowFrustum {
   int resolution = 1024; ///< texels per side
 };
 
-/// A unit vector perpendicular to v (zero for v = 0); used to complete view frames.
-Vec3d any_perpendicular(const Vec3d& v);
-
 /// Frustum at `eye_ws` looking toward the centroid of `points` whose window encloses every point at
 /// least `z_near` in front of the eye (the others are ignored), each half-angle capped at 80 degrees.
 /// With no usable point it looks along `fallback_forward` with a 90 degree window.

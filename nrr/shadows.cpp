@@ -59,12 +59,18 @@ std::vector<mesh::TriMesh> discretize_and_reconstruct(const SampledScene& scene,
   const bool hybrid = options.reconstruction_kind == ReconstructionKind::Hybrid ||
                       (options.reconstruction_kind == ReconstructionKind::Auto && method != ShadowMethod::Conventional);
   Timer timer;
-  const std::vector<DepthImage> images = render_depth_images(scene, Span<const CameraSpec>(views), sampling);
+  std::vector<DepthImage> images = render_depth_images(scene, Span<const CameraSpec>(views), sampling);
   std::vector<DepthImage> corners;
   if (hybrid) {
     std::vector<CameraSpec> corner_views;
     for (const CameraSpec& v : views) corner_views.push_back(corner_camera(v));
     corners = render_depth_images(scene, Span<const CameraSpec>(corner_views), sampling);
+  }
+  if (options.use_face_normals) {
+    for (std::vector<DepthImage>* set : {&images, &corners})
+      for (DepthImage& image : *set)
+        for (std::size_t p = 0; p < image.pixel_count(); ++p)
+          if (image.has_sample(p)) image.normal_ws[p] = Vec3f(scene.face_normal(image.triangle_id[p]));
   }
   result.times_ms.depth_images = timer.elapsed_ms();
   for (const DepthImage& image : images) result.depth_samples += image.sample_count();

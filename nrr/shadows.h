@@ -64,6 +64,10 @@ struct ShadowOptions {
   int depth_image_resolution = 1024;  ///< conventional/nrr/peel depth images, pixels per side
   SamplingMode nrr_redundancy = SamplingMode::NrrVisibility;  ///< NrrPixel or NrrVisibility
   ReconstructionKind reconstruction_kind = ReconstructionKind::Auto;
+  /// Tangent planes from the hit triangle's face normal (true) or the sampler's interpolated shading
+  /// normal (false). Face normals keep box edges sharp: a shading normal averaged across a 90 degree
+  /// edge tilts the tangent plane by 45 degrees and the corner estimates with it.
+  bool use_face_normals = true;
   ReconstructionOptions reconstruction;
 };
 

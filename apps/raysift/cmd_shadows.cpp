@@ -28,6 +28,7 @@ struct ShadowsOptions {
   int shadow_map_resolution = 0;  ///< 0 = --resolution
   int width = 512, height = 512;
   std::string fit = "scene", reconstruction = "auto", redundancy = "visibility";
+  bool shading_normals = false;
   CLI::Option* width_flag = nullptr;
   CLI::Option* height_flag = nullptr;
   nrr::ShadowOptions lib;  ///< bias, offset and reconstruction thresholds keep their library defaults
@@ -88,6 +89,8 @@ RegisterCommand reg(
                      "depth-discontinuity threshold, fraction of depth")->capture_default_str();
       sub.add_option("--corner-clamp", opt->lib.reconstruction.corner_clamp_rel,
                      "hybrid: estimated corners stay within this fraction of the sample depth")->capture_default_str();
+      sub.add_flag("--shading-normals", opt->shading_normals,
+                   "reconstruct with interpolated shading normals instead of face normals");
       sub.add_option("--camera", opt->camera, "output camera JSON (default: the scene's, else a view from the light side)");
       opt->width_flag = sub.add_option("--width", opt->width, "output width, pixels (overrides the camera's)")
                             ->capture_default_str();
@@ -134,6 +137,7 @@ RegisterCommand reg(
         options.nrr_redundancy =
             opt->redundancy == "visibility" ? nrr::SamplingMode::NrrVisibility : nrr::SamplingMode::NrrPixel;
         options.reconstruction_kind = parse_reconstruction(opt->reconstruction);
+        options.use_face_normals = !opt->shading_normals;
 
         // Inputs: the mesh, optional scene fields (camera, light), then flags override.
         Scene scene;
