@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <sstream>
 
 #include "core/image.h"
@@ -21,12 +22,14 @@ struct CliRun {
   std::string err;
 };
 
-CliRun raysift(const std::string& dir, const std::string& args) {
-  const std::string cmd = "cd '" + dir + "' && '" + RAYSIFT_EXE + "' " + args + " >stdout.txt 2>stderr.txt";
+/// Runs raysift in `dir`; stdout/stderr go to stdout<tag>.txt / stderr<tag>.txt.
+CliRun raysift(const std::string& dir, const std::string& args, const std::string& tag = "") {
+  const std::string cmd = "cd '" + dir + "' && '" + RAYSIFT_EXE + "' " + args + " >stdout" + tag + ".txt 2>stderr" +
+                          tag + ".txt";
   const int status = std::system(cmd.c_str());
   CliRun r;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream in(dir + "/stderr.txt");
+  std::ifstream in(dir + "/stderr" + tag + ".txt");
   std::stringstream s;
   s << in.rdbuf();
   r.err = s.str();
@@ -114,12 +117,18 @@ TEST(RenderCli, BadInputFailsWithoutOutput) {
       {"--tf tf.json --camera cam_flat.json", 1, "cam_flat.json"},
       {"--tf missing.json", 1, "missing.json"},
   };
-  for (const auto& c : cases) {
-    const CliRun r = raysift(dir, "render ball.vdb --width 8 --height 8 -o out.exr " + c.args);
-    EXPECT_EQ(r.code, c.code) << c.args << ": " << r.err;
-    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << ": " << r.err;
-    EXPECT_FALSE(fs::exists(dir + "/out.exr")) << c.args;
+  // Concurrent: process start-up (hundreds of shared libraries) dominates each run.
+  std::vector<std::future<CliRun>> runs;
+  for (std::size_t i = 0; i < std::size(cases); ++i)
+    runs.push_back(std::async(std::launch::async, [&, i] {
+      return raysift(dir, "render ball.vdb --width 8 --height 8 -o out.exr " + cases[i].args, std::to_string(i));
+    }));
+  for (std::size_t i = 0; i < std::size(cases); ++i) {
+    const CliRun r = runs[i].get();
+    EXPECT_EQ(r.code, cases[i].code) << cases[i].args << ": " << r.err;
+    EXPECT_NE(r.err.find(cases[i].message), std::string::npos) << cases[i].args << ": " << r.err;
   }
+  EXPECT_FALSE(fs::exists(dir + "/out.exr"));
   const CliRun ext = raysift(dir, "render ball.vdb --tf tf.json -o out.jpg");
   EXPECT_EQ(ext.code, 2);
   EXPECT_FALSE(fs::exists(dir + "/out.jpg"));
