@@ -138,6 +138,27 @@ TEST_P(AllConfigurations, EveryCaseIsWatertight) {
 
 INSTANTIATE_TEST_SUITE_P(CellPositions, AllConfigurations, ::testing::Values(2, 7));
 
+TEST(MarchingCubes, RandomFieldIsAClosedManifold) {
+  // White noise makes every case, including adjacent ambiguous faces and cells, appear many times; an
+  // edge shared by four triangles (two cells triangulating across their common face) would show here.
+  DenseSpec spec;
+  spec.dims = {24, 24, 24};
+  const Volume v = Volume::from_function(spec, [](int i, int j, int k) {
+    std::uint64_t z = std::uint64_t((k * 24 + j) * 24 + i) * 0x9E3779B97F4A7C15ull + 1;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return float((z ^ (z >> 31)) >> 40) / float(1 << 24);  // uniform in [0, 1)
+  });
+  for (const double iso : {0.3, 0.5, 0.7}) {
+    const MeshAnalysis a = analyze_mesh(extract_isosurface(v, iso));
+    EXPECT_GT(a.faces, 10000u) << iso;
+    EXPECT_TRUE(a.is_watertight()) << "iso " << iso << ": boundary " << a.boundary_edges << ", non-manifold "
+                                   << a.non_manifold_edges << "/" << a.non_manifold_vertices << ", inconsistent "
+                                   << a.inconsistent_edges;
+    EXPECT_EQ(a.degenerate_faces, 0u) << iso;
+  }
+}
+
 TEST(MarchingCubes, IntegerTiesGiveNoDegenerateTriangles) {
   // u8-style data: a quantised cone around a centre, so many voxels equal the integer iso-value exactly,
   // plus a flat terrace where a whole plane of voxels equals it.

@@ -18,6 +18,40 @@ int edge_between(int a, int b) {
   return 8 + (lo & 3);
 }
 
+/// True if cube edges a and b lie on a common cube face. Edge e (axis a, start corner c) lies on the face
+/// {x_f = bit f of c} for each axis f != a, so two edges share a face when such an f agrees.
+bool share_face(int a, int b) {
+  for (int f = 0; f < 3; ++f)
+    if (f != edge_axis(a) && f != edge_axis(b) && ((kEdgeStart[a] >> f) & 1) == ((kEdgeStart[b] >> f) & 1))
+      return true;
+  return false;
+}
+
+/// Triangulates the closed polygon `poly` (cube edges in loop order) by cutting off ears, so that no new
+/// edge joins two vertices on a common cube face: such an edge would lie in that face, where the
+/// neighbouring cell may create the same edge, giving it four triangles. Interior diagonals cannot be
+/// shared with another cell. Returns false if impossible; tries apexes in order (deterministic).
+bool triangulate(const std::vector<int>& poly, std::vector<std::array<int, 3>>& out) {
+  const std::size_t n = poly.size();
+  if (n == 3) {
+    out.push_back({poly[0], poly[1], poly[2]});
+    return true;
+  }
+  // Cut off the triangle (poly[i], poly[i+1], poly[i+2]) through the diagonal poly[i] - poly[i+2].
+  for (std::size_t i = 0; i < n; ++i) {
+    const int a = poly[i], b = poly[(i + 1) % n], c = poly[(i + 2) % n];
+    if (share_face(a, c)) continue;
+    std::vector<int> rest;
+    for (std::size_t k = 0; k < n; ++k)
+      if (k != (i + 1) % n) rest.push_back(poly[k]);
+    const std::size_t mark = out.size();
+    out.push_back({a, b, c});
+    if (triangulate(rest, out)) return true;
+    out.resize(mark);
+  }
+  return false;
+}
+
 Vec3d edge_midpoint(int e) {
   const int c = kEdgeStart[e];
   Vec3d p(c & 1, (c >> 1) & 1, (c >> 2) & 1);
@@ -57,12 +91,12 @@ McCase build_case(int index) {
       result.cut_edges |= std::uint16_t(1u << e);
     }
     RAYSIFT_CHECK_OP(loop.front(), ==, next_edge[loop.back()]);
-    for (std::size_t k = 1; k + 1 < loop.size(); ++k) {
+    std::vector<std::array<int, 3>> triangles;
+    RAYSIFT_CHECK(triangulate(loop, triangles));
+    for (const auto& t : triangles) {
       RAYSIFT_CHECK_OP(int(result.triangle_count), <, kMcMaxTriangles);
       std::uint8_t* tri = &result.edges[3 * result.triangle_count++];
-      tri[0] = std::uint8_t(loop[0]);
-      tri[1] = std::uint8_t(loop[k]);
-      tri[2] = std::uint8_t(loop[k + 1]);
+      for (int k = 0; k < 3; ++k) tri[k] = std::uint8_t(t[k]);
     }
   }
   return result;

@@ -8,7 +8,8 @@
 /// segment, so two diagonal inside corners of an ambiguous face are never joined. The rule depends only on
 /// the face's four corners, hence the two cells sharing a face always cut it the same way: the surface is
 /// crack-free and closed (no complement symmetry is used). Segments chain into loops, one per surface
-/// patch, which are fan-triangulated. Triangles are counter-clockwise seen from the outside (f < iso) side.
+/// patch, which are triangulated without any edge across a cube face (such an edge could be created by both
+/// cells sharing the face). Triangles are counter-clockwise seen from the outside (f < iso) side.
 #include <array>
 #include <cstdint>
 
