@@ -243,6 +243,12 @@ FeatureLines extract_lines(const mesh::TriMesh& mesh, const mesh::MeshCurvature&
     throw InvalidInput("feature lines: the curvature was computed for a different mesh (" +
                        std::to_string(curvature.k1.size()) + " vs " + std::to_string(mesh.vertex_count()) +
                        " vertices); recompute it");
+  for (double t : {options.suggestive_threshold, options.highlight_threshold, options.ridge_threshold})
+    if (!(t >= 0 && std::isfinite(t)))
+      throw InvalidInput("feature lines: thresholds must be finite and >= 0, got " + std::to_string(t));
+  FeatureLines lines;
+  // No usable vertex (e.g. every face has zero area): no lines, and no division by a zero feature size.
+  if (!(curvature.feature_size > 0)) return lines;
   const LineClassSet cls = options.classes;
   const bool do_contours = cls.has(LineClass::Contour) || cls.has(LineClass::Silhouette);
   const bool do_sc = cls.has(LineClass::SuggestiveContour), do_sh = cls.has(LineClass::SuggestiveHighlight);
@@ -283,7 +289,6 @@ FeatureLines extract_lines(const mesh::TriMesh& mesh, const mesh::MeshCurvature&
   } else {
     for (std::size_t ci = 0; ci < chunks; ++ci) run_chunk(ci);
   }
-  FeatureLines lines;
   std::size_t total = 0;
   for (const auto& p : parts) total += p.size();
   lines.segments.reserve(total);

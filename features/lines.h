@@ -68,7 +68,8 @@ struct LineOptions {
 /// Faces touching a vertex that MeshCurvature marks invalid (non-manifold, unreferenced) and degenerate
 /// faces are skipped. The result is identical for any thread count.
 /// \pre `curvature` was computed from `mesh` (same vertex count).
-/// \throw InvalidInput if the eye is not finite or the curvature does not match the mesh.
+/// \throw InvalidInput if the eye is not finite, a threshold is negative or not finite, or the curvature
+///        does not match the mesh.
 FeatureLines extract_lines(const mesh::TriMesh& mesh, const mesh::MeshCurvature& curvature, const Vec3d& eye_ws,
                            const LineOptions& options = {});
 

@@ -231,11 +231,31 @@ TEST(Lines, ParsesClassNamesAndRejectsUnknownOnes) {
   EXPECT_THROW(parse_line_classes(""), InvalidInput);
 }
 
-TEST(Lines, RejectsMismatchedCurvatureAndNonFiniteEye) {
+TEST(Lines, RejectsMismatchedCurvatureNonFiniteEyeAndBadOptions) {
   const mesh::TriMesh a = mesh::make_icosphere(1.0, 1), b = mesh::make_icosphere(1.0, 2);
   const mesh::MeshCurvature ca = mesh::compute_curvature(a);
   EXPECT_THROW(extract_lines(b, ca, {0, 0, 5}), InvalidInput);
   EXPECT_THROW(extract_lines(a, ca, {0, NAN, 5}), InvalidInput);
+  LineOptions o;
+  o.ridge_threshold = -0.1;
+  EXPECT_THROW(extract_lines(a, ca, {0, 0, 5}, o), InvalidInput);
+  const DepthBuffer depth = rasterize_depth(a, Camera(camera_at({0, 0, 5}, 32)));
+  VisibilityOptions v;
+  v.step_px = 0;
+  EXPECT_THROW(remove_hidden_lines({}, depth, v), InvalidInput);
+  v = {};
+  v.depth_tolerance = 1.0;
+  EXPECT_THROW(remove_hidden_lines({}, depth, v), InvalidInput);
+}
+
+TEST(Lines, AllZeroAreaFacesGiveNoLinesAndNoError) {
+  mesh::TriMesh flat;
+  flat.positions = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0}};
+  flat.triangles = {{0, 1, 2}, {1, 2, 3}};  // collinear: zero area
+  const mesh::MeshCurvature c = mesh::compute_curvature(flat);
+  EXPECT_EQ(c.degenerate_faces, 2u);
+  for (std::uint8_t valid : c.is_valid) EXPECT_EQ(valid, 0);
+  EXPECT_TRUE(extract_lines(flat, c, {1, 1, 5}).segments.empty());
 }
 
 }  // namespace
