@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "core/errors.h"
+#include "mesh/primitives.h"
 #include "mesh/ray_scene.h"
 #include "nrr/area_light.h"
 #include "nrr/scenes.h"
@@ -175,12 +176,15 @@ TEST(SoftShadows, ShadowMapCloseToRaytraceAndDeterministic) {
   options.light_samples_per_side = 8;
   options.shadow_map_resolution = 512;
   const ShadowResult exact = render_shadows(setup.mesh, setup.scene, rec, setup.light, ShadowMethod::Raytrace, options);
-  VisibilitySet maps[2];
+  VisibilitySet maps[2], rays[2];
   for (int threads : {1, 2}) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
     maps[threads - 1] = render_shadows(setup.mesh, setup.scene, rec, setup.light, ShadowMethod::ShadowMap, options).visibility;
+    rays[threads - 1] = render_shadows(setup.mesh, setup.scene, rec, setup.light, ShadowMethod::Raytrace, options).visibility;
   }
   EXPECT_EQ(maps[0].bits, maps[1].bits);
+  EXPECT_EQ(rays[0].bits, rays[1].bits);
+  EXPECT_EQ(rays[0].bits, exact.visibility.bits);
   const ShadowErrors e = compute_shadow_errors(maps[0], exact.visibility, Span<const std::uint8_t>(rec.is_hit));
   // The only disagreements are rays that cross the occluder plane within a texel of the occluder's
   // edge (no acne on the ground, no leaks). The occluder is aligned with the sample grid, so a whole
@@ -233,6 +237,28 @@ TEST(SoftShadows, NrrBeatsConventionalOnBlocks4AndGrass) {
     }
     EXPECT_LT(error[0], error[1]) << name << ": nrr " << error[0] << " vs conventional " << error[1];
   }
+}
+
+// A light inside a closed surface: exact shadow rays leave every outside receiver in full shadow, and
+// the depth images from the light see only back faces (culled), so the depth-image methods report an
+// empty reconstruction instead of inventing shadows.
+TEST(SoftShadows, LightInsideGeometry) {
+  const mesh::TriMesh sphere = mesh::make_icosphere(1.0, 2);
+  const SampledScene scene(sphere);
+  CameraSpec cam;
+  cam.eye = {0, 0, 4};
+  cam.width = cam.height = 24;
+  const Receivers rec = trace_receivers(scene.rays(), Camera(cam));
+  const AreaLight light{{0, 0, 0.2}, {0.2, 0, 0}, {0, 0.2, 0}};  // emits toward +z, inside the sphere
+  ShadowOptions o;
+  o.light_samples_per_side = 2;
+  o.depth_image_resolution = o.shadow_map_resolution = 32;
+  const ShadowResult exact = render_shadows(sphere, scene, rec, light, ShadowMethod::Raytrace, o);
+  int hits = 0;
+  for (int c : exact.visibility.visible_counts()) EXPECT_EQ(c, 0);
+  for (std::uint8_t h : rec.is_hit) hits += h;
+  EXPECT_GT(hits, 100);
+  EXPECT_THROW(render_shadows(sphere, scene, rec, light, ShadowMethod::Nrr, o), InvalidInput);
 }
 
 TEST(ShadowErrors, CountsWrongSamplesAndCancelsOppositeErrors) {
