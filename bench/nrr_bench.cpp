@@ -2,7 +2,7 @@
 // views in one run: render time of nrr-pixel and nrr-visibility relative to conventional images
 // (target: nrr-pixel <= 1.5x), the conventional sampler's rays/s relative to bare Embree rtcIntersect16
 // primary rays on the same mesh and camera (target >= 50%), and the paper's Table 1 and Table 2
-// (Xie, Wang & Popescu 2016) with pixel redundancy.
+// (Xie, Wang & Popescu 2016) with pixel redundancy, plus Table 2 with visibility redundancy.
 //
 // Usage: nrr_bench [resolution=1024] [metrics_resolution=512] [intermediate_views=100] [real_mesh]
 #include <embree3/rtcore.h>
@@ -193,60 +193,82 @@ int main(int argc, char** argv) {
                 100.0 * bare_ms / conv_view0_ms);
   }
 
-  std::printf("\nSampling metrics, pixel redundancy, %dx%d images, %d intermediate frames\n", metrics_res, metrics_res,
-              n_intermediate);
-  std::vector<std::vector<ModeRow>> rows(scenes.size());
-  for (std::size_t si = 0; si < scenes.size(); ++si) {
-    const nrr::SampledScene scene(scenes[si].mesh);
-    const auto views = sized(scenes[si].views, metrics_res);
-    const auto frames = nrr::intermediate_views(Span<const CameraSpec>(views), n_intermediate);
-    nrr::SamplingOptions conv_o;
-    conv_o.mode = nrr::SamplingMode::Conventional;
-    const auto conv = nrr::render_depth_images(scene, Span<const CameraSpec>(views), conv_o);
-    for (nrr::SamplingMode mode : {nrr::SamplingMode::Conventional, nrr::SamplingMode::NrrPixel, nrr::SamplingMode::Peel}) {
-      nrr::SamplingOptions o;
-      o.mode = mode;
-      const auto images = mode == nrr::SamplingMode::Conventional
-                              ? conv
-                              : nrr::render_depth_images(scene, Span<const CameraSpec>(views), o);
-      rows[si].push_back({mode, nrr::compute_sampling_metrics(scene, mode, Span<const CameraSpec>(views),
-                                                              Span<const nrr::DepthImage>(images),
-                                                              Span<const nrr::DepthImage>(conv),
-                                                              Span<const CameraSpec>(frames))});
+  // Pixel redundancy as in the paper's tables; then Table 2 again with visibility redundancy (the
+  // resolution-independent limit, NRR Fig. 7) at a quarter of the pixels and a fifth of the frames,
+  // because its occlusion rays cost much more.
+  struct Pass {
+    nrr::Redundancy redundancy;
+    int res, frames;
+    std::vector<nrr::SamplingMode> modes;
+  };
+  const Pass passes[2] = {
+      {nrr::Redundancy::Pixel, metrics_res, n_intermediate,
+       {nrr::SamplingMode::Conventional, nrr::SamplingMode::NrrPixel, nrr::SamplingMode::Peel}},
+      {nrr::Redundancy::Visibility, metrics_res / 2, std::max(1, n_intermediate / 5),
+       {nrr::SamplingMode::Conventional, nrr::SamplingMode::NrrVisibility, nrr::SamplingMode::Peel}}};
+  for (const Pass& pass : passes) {
+    const bool is_pixel = pass.redundancy == nrr::Redundancy::Pixel;
+    std::printf("\nSampling metrics, %s redundancy, %dx%d images, %d intermediate frames\n",
+                is_pixel ? "pixel" : "visibility", pass.res, pass.res, pass.frames);
+    std::vector<std::vector<ModeRow>> rows(scenes.size());
+    for (std::size_t si = 0; si < scenes.size(); ++si) {
+      const nrr::SampledScene scene(scenes[si].mesh);
+      const auto views = sized(scenes[si].views, pass.res);
+      const auto frames = nrr::intermediate_views(Span<const CameraSpec>(views), pass.frames);
+      nrr::SamplingOptions conv_o;
+      conv_o.mode = nrr::SamplingMode::Conventional;
+      const auto conv = nrr::render_depth_images(scene, Span<const CameraSpec>(views), conv_o);
+      nrr::MetricsOptions mo;
+      mo.redundancy = pass.redundancy;
+      for (nrr::SamplingMode mode : pass.modes) {
+        nrr::SamplingOptions o;
+        o.mode = mode;
+        const auto images = mode == nrr::SamplingMode::Conventional
+                                ? conv
+                                : nrr::render_depth_images(scene, Span<const CameraSpec>(views), o);
+        rows[si].push_back({mode, nrr::compute_sampling_metrics(scene, mode, Span<const CameraSpec>(views),
+                                                                Span<const nrr::DepthImage>(images),
+                                                                Span<const nrr::DepthImage>(conv),
+                                                                Span<const CameraSpec>(frames), mo)});
+      }
+      std::printf("  %s: mean triangle edge / pixel size at the scene centre = %.2f\n", scenes[si].name.c_str(),
+                  scene.mean_edge_length() /
+                      (2.0 * length(scene.rays().bounds().center() - views[0].eye) *
+                       std::tan(views[0].fov_y_deg * M_PI / 360.0) / pass.res));
     }
-    std::printf("  %s: triangle edge / pixel = %.2f\n", scenes[si].name.c_str(),
-                scene.mean_edge_length() /
-                    (2.0 * length(scene.rays().bounds().center() - views[0].eye) *
-                     std::tan(views[0].fov_y_deg * M_PI / 360.0) / metrics_res));
-  }
-
-  std::printf("\nTable 1  View-independent sampling metrics (%% of the image's samples; useful in %% of disoccluded)\n");
-  std::printf("%-14s %16s %16s %16s\n", "Model", "Image 0 (%)", "Image 1 (%)", "Image 2 (%)");
-  const char* titles[3] = {"Redundant samples for conventional sampling",
-                           "Disoccluded and (useful) samples for non-redundant rendering",
-                           "Disoccluded and (useful) samples for depth peeling"};
-  for (int k = 0; k < 3; ++k) {
-    std::printf("%s\n", titles[k]);
+    if (is_pixel) {
+      std::printf("\nTable 1  View-independent sampling metrics (%% of the image's samples; useful in %% of "
+                  "disoccluded)\n");
+      std::printf("%-14s %16s %16s %16s\n", "Model", "Image 0 (%)", "Image 1 (%)", "Image 2 (%)");
+      const char* titles[3] = {"Redundant samples for conventional sampling",
+                               "Disoccluded and (useful) samples for non-redundant rendering",
+                               "Disoccluded and (useful) samples for depth peeling"};
+      for (int k = 0; k < 3; ++k) {
+        std::printf("%s\n", titles[k]);
+        for (std::size_t si = 0; si < scenes.size(); ++si) {
+          std::printf("%-14s", scenes[si].name.c_str());
+          for (const nrr::ImageMetrics& im : rows[si][std::size_t(k)].metrics.images) {
+            char cell[32];
+            if (k == 0)
+              std::snprintf(cell, sizeof cell, "%.0f", pct(im.redundant, im.samples));
+            else
+              std::snprintf(cell, sizeof cell, "%.0f (%.0f)", pct(im.disoccluded, im.samples),
+                            pct(im.useful, im.disoccluded));
+            std::printf(" %16s", cell);
+          }
+          std::printf("\n");
+        }
+      }
+    }
+    std::printf("\nTable 2  View-dependent sampling metric, %s redundancy (%% of intermediate-frame samples "
+                "available)\n", is_pixel ? "pixel" : "visibility");
+    std::printf("%-14s %10s %10s %10s %10s %10s %10s\n", "Model", "Conv avg", "Conv min", "NRR avg", "NRR min",
+                "Peel avg", "Peel min");
     for (std::size_t si = 0; si < scenes.size(); ++si) {
       std::printf("%-14s", scenes[si].name.c_str());
-      for (const nrr::ImageMetrics& im : rows[si][std::size_t(k)].metrics.images) {
-        char cell[32];
-        if (k == 0)
-          std::snprintf(cell, sizeof cell, "%.0f", pct(im.redundant, im.samples));
-        else
-          std::snprintf(cell, sizeof cell, "%.0f (%.0f)", pct(im.disoccluded, im.samples), pct(im.useful, im.disoccluded));
-        std::printf(" %16s", cell);
-      }
+      for (const ModeRow& r : rows[si]) std::printf(" %10.1f %10.1f", r.metrics.available_avg_pct, r.metrics.available_min_pct);
       std::printf("\n");
     }
-  }
-  std::printf("\nTable 2  View-dependent sampling metric (%% of intermediate-frame samples available)\n");
-  std::printf("%-14s %10s %10s %10s %10s %10s %10s\n", "Model", "Conv avg", "Conv min", "NRR avg", "NRR min", "Peel avg",
-              "Peel min");
-  for (std::size_t si = 0; si < scenes.size(); ++si) {
-    std::printf("%-14s", scenes[si].name.c_str());
-    for (const ModeRow& r : rows[si]) std::printf(" %10.1f %10.1f", r.metrics.available_avg_pct, r.metrics.available_min_pct);
-    std::printf("\n");
   }
   return 0;
 }

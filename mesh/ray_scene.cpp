@@ -76,21 +76,26 @@ void context_filter(const RTCFilterFunctionNArguments* args) {
   }
 }
 
-/// Culling-only closest-hit queries first run without any callback (bare Embree speed); only rays
-/// whose nearest hit is a back face are traced again with the culling filter. Both passes together
-/// return the nearest front-facing hit, as one culled traversal would.
-QueryOptions without_culling(const QueryOptions& options) {
-  QueryOptions plain = options;
-  plain.cull_back_faces = false;
-  return plain;
-}
-
 void init_context(FilterContext& ctx, const QueryOptions& options) {
   rtcInitIntersectContext(&ctx.rtc);
   ctx.options = &options;
   if (options.is_coherent) ctx.rtc.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
   // Without culling or a filter no callback is installed, so plain queries cost what bare Embree costs.
   if (options.cull_back_faces || options.filter) ctx.rtc.filter = context_filter;
+}
+
+/// Closest-hit queries whose culling/filter only decides can run in two passes: a plain traversal
+/// without callbacks (bare Embree speed), then, for rays whose nearest hit the options reject, a
+/// traversal with the callbacks. Both together return the nearest accepted hit, as one filtered
+/// traversal would.
+bool is_two_pass(const QueryOptions& options) {
+  return options.filter ? options.is_filter_pure : options.cull_back_faces;
+}
+
+/// Whether `options` accept a hit found by the plain pass.
+bool accepts(const QueryOptions& options, HitCandidate& c) {
+  if (options.cull_back_faces && !c.is_front_facing()) return false;
+  return !options.filter || (*options.filter)(c);
 }
 
 bool is_valid_ray(const RayF& r) {
@@ -231,10 +236,10 @@ std::size_t RayScene::degenerate_triangle_count() const { return impl_->degenera
 
 Hit RayScene::intersect(const RayF& ray, const QueryOptions& options) const {
   if (!is_valid_ray(ray)) return {};
-  const bool is_cull_only = options.cull_back_faces && !options.filter;
-  const QueryOptions first_pass = is_cull_only ? without_culling(options) : options;  // outlives ctx's use
+  const bool two_pass = is_two_pass(options);
+  const QueryOptions plain{false, nullptr, false, options.is_coherent};
   FilterContext ctx;
-  init_context(ctx, first_pass);
+  init_context(ctx, two_pass ? plain : options);
   RTCRayHit rh;
   const auto reset = [&] {
     rh.ray.org_x = ray.origin.x;
@@ -254,11 +259,20 @@ Hit RayScene::intersect(const RayF& ray, const QueryOptions& options) const {
   };
   reset();
   rtcIntersect1(impl_->scene, &ctx.rtc, &rh);
-  if (is_cull_only && rh.hit.geomID != RTC_INVALID_GEOMETRY_ID &&
-      rh.hit.Ng_x * ray.direction.x + rh.hit.Ng_y * ray.direction.y + rh.hit.Ng_z * ray.direction.z >= 0.0f) {
-    reset();
-    init_context(ctx, options);
-    rtcIntersect1(impl_->scene, &ctx.rtc, &rh);
+  if (two_pass && rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
+    HitCandidate c;
+    c.origin = ray.origin;
+    c.direction = ray.direction;
+    c.t = rh.ray.tfar;
+    c.triangle_id = make_triangle_id(rh.hit.geomID, rh.hit.primID);
+    c.geometric_normal = {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};
+    c.u = rh.hit.u;
+    c.v = rh.hit.v;
+    if (!accepts(options, c)) {
+      reset();
+      init_context(ctx, options);
+      rtcIntersect1(impl_->scene, &ctx.rtc, &rh);
+    }
   }
   return hit_from(rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z, rh.hit.u, rh.hit.v);
 }
@@ -292,11 +306,11 @@ void fill_packet(Ray16& r, int* valid, Span<const RayF> rays, std::size_t base, 
 void RayScene::intersect(Span<const RayF> rays, Span<Hit> hits, const QueryOptions& options) const {
   RAYSIFT_CHECK_OP(hits.size(), ==, rays.size());
   RAYSIFT_CHECK(rays.size() < std::size_t(std::numeric_limits<std::uint32_t>::max()));
-  const bool is_cull_only = options.cull_back_faces && !options.filter;
-  const QueryOptions first_pass = is_cull_only ? without_culling(options) : options;  // outlives ctx's use
-  FilterContext ctx, cull_ctx;
-  init_context(ctx, first_pass);
-  init_context(cull_ctx, options);
+  const bool two_pass = is_two_pass(options);
+  const QueryOptions plain{false, nullptr, false, options.is_coherent};
+  FilterContext ctx, full_ctx;
+  init_context(ctx, two_pass ? plain : options);
+  init_context(full_ctx, options);
   alignas(64) RTCRayHit16 rh;
   alignas(64) int valid[kPacket];
   alignas(64) int again[kPacket];
@@ -308,19 +322,27 @@ void RayScene::intersect(Span<const RayF> rays, Span<Hit> hits, const QueryOptio
       rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
     }
     rtcIntersect16(valid, impl_->scene, &ctx.rtc, &rh);
-    if (is_cull_only) {
-      bool has_back_face = false;
+    if (two_pass) {
+      bool has_rejected = false;
       for (std::size_t i = 0; i < kPacket; ++i) {
-        const bool is_back = valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID &&
-                             rh.hit.Ng_x[i] * rh.ray.dir_x[i] + rh.hit.Ng_y[i] * rh.ray.dir_y[i] +
-                                     rh.hit.Ng_z[i] * rh.ray.dir_z[i] >= 0.0f;
-        again[i] = is_back ? -1 : 0;
-        if (!is_back) continue;
-        has_back_face = true;
+        again[i] = 0;
+        if (!valid[i] || rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
+        HitCandidate c;
+        c.ray_index = base + i;
+        c.origin = rays[base + i].origin;
+        c.direction = rays[base + i].direction;
+        c.t = rh.ray.tfar[i];
+        c.triangle_id = make_triangle_id(rh.hit.geomID[i], rh.hit.primID[i]);
+        c.geometric_normal = {rh.hit.Ng_x[i], rh.hit.Ng_y[i], rh.hit.Ng_z[i]};
+        c.u = rh.hit.u[i];
+        c.v = rh.hit.v[i];
+        if (accepts(options, c)) continue;
+        again[i] = -1;
+        has_rejected = true;
         rh.ray.tfar[i] = rays[base + i].t_far;
         rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
       }
-      if (has_back_face) rtcIntersect16(again, impl_->scene, &cull_ctx.rtc, &rh);
+      if (has_rejected) rtcIntersect16(again, impl_->scene, &full_ctx.rtc, &rh);
     }
     for (std::size_t i = 0; i < count; ++i)
       hits[base + i] = valid[i] ? hit_from(rh.ray.tfar[i], rh.hit.geomID[i], rh.hit.primID[i], rh.hit.Ng_x[i],

@@ -63,6 +63,11 @@ using HitFilter = std::function<bool(const HitCandidate&)>;
 struct QueryOptions {
   bool cull_back_faces = false;       ///< reject candidates with dot(Ng, direction) >= 0
   const HitFilter* filter = nullptr;  ///< optional, called after culling for surviving candidates
+  /// The filter only decides (no side effects, same answer for the same candidate). Closest-hit
+  /// queries then first trace without callbacks and ask the filter about the nearest hit only; rays
+  /// whose nearest hit is rejected are traced again with the filter. Leave false for filters that
+  /// collect candidates (they would miss some). Culling alone always takes this fast path.
+  bool is_filter_pure = false;
   bool is_coherent = false;           ///< hint: rays of a batch are coherent (primary camera rays)
 };
 

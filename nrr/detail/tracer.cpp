@@ -101,6 +101,8 @@ void trace(const SampledScene& scene, const ImageRule& rule, Span<const mesh::Ra
           if (pixel_captured(rule.previous[j], rule.previous_cameras[j], x, c.triangle_id)) return false;
         return true;
       };
+      // The filter is pure, but QueryOptions::is_filter_pure stays off: redundancy rejects 15-50 % of
+      // the nearest hits of later images, and re-tracing those measured slower than one filtered pass.
       options.filter = &keep_non_redundant;
       scene.rays().intersect(rays, hits, options);
       return;

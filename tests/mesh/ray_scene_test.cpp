@@ -110,10 +110,22 @@ TEST(RayScene, RejectingFilterContinuesToNextHit) {
   HitFilter reject_top = [](const HitCandidate& c) { return triangle_id_index(c.triangle_id) < 4; };
   QueryOptions opt;
   opt.filter = &reject_top;
-  const Hit h = scene.intersect(ray({0.2f, 0.3f, 5}, {0, 0, -1}), opt);
-  ASSERT_TRUE(h.is_hit());
-  EXPECT_FLOAT_EQ(h.t, 4.0f);
-  EXPECT_EQ(triangle_id_index(h.triangle_id) / 2, 1u);
+  for (bool is_pure : {false, true}) {  // one filtered traversal, or plain first and filtered again
+    opt.is_filter_pure = is_pure;
+    const Hit h = scene.intersect(ray({0.2f, 0.3f, 5}, {0, 0, -1}), opt);
+    ASSERT_TRUE(h.is_hit());
+    EXPECT_FLOAT_EQ(h.t, 4.0f);
+    EXPECT_EQ(triangle_id_index(h.triangle_id) / 2, 1u);
+    std::vector<RayF> rays(20, ray({0.2f, 0.3f, 5}, {0, 0, -1}));
+    rays[3].origin.z = 1.5f;  // starts between the quads at z = 1 and z = 2: the nearest hit is accepted
+    std::vector<Hit> hits(rays.size());
+    scene.intersect(Span<const RayF>(rays), Span<Hit>(hits), opt);
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      EXPECT_EQ(triangle_id_index(hits[i].triangle_id) / 2, 1u);
+      EXPECT_FLOAT_EQ(hits[i].t, i == 3 ? 0.5f : 4.0f);
+    }
+  }
+  opt.is_filter_pure = false;
   // Rejecting everything gives a miss; the filter saw all three quads.
   std::set<std::uint32_t> quads_seen;
   HitFilter reject_all = [&](const HitCandidate& c) {
