@@ -67,7 +67,8 @@ VolumeBricks build_volume_bricks_from_grid(const openvdb::FloatGrid& grid) {
     if (needs[i]) out.brick[i] = bricks++;
   out.values.resize(std::size_t(bricks) * kBrickVoxels);
 
-  // Pass 2: fill bricks (the own leaf is copied, the apron read through the accessor) and ranges.
+  // Pass 2: fill bricks and ranges. A brick's 9³ voxels come from the block's own leaf and its 7
+  // neighbours towards +x, +y, +z (each a leaf buffer or one constant tile/background value).
   for_each_block([&](auto& acc, const openvdb::Coord& origin, std::size_t idx) {
     float lo = std::numeric_limits<float>::infinity(), hi = -lo;
     auto add = [&](float v) {
@@ -78,14 +79,20 @@ VolumeBricks build_volume_bricks_from_grid(const openvdb::FloatGrid& grid) {
     if (out.brick[idx] < 0) {
       add(out.constant[idx]);
     } else {
+      const float* src[8];
+      float tile[8];
+      for (int c = 0; c < 8; ++c) {
+        const openvdb::Coord o = origin.offsetBy((c >> 2) * kBlockSize, (c >> 1 & 1) * kBlockSize, (c & 1) * kBlockSize);
+        const Tree::LeafNodeType* leaf = acc.probeConstLeaf(o);
+        src[c] = leaf ? leaf->buffer().data() : nullptr;
+        tile[c] = leaf ? 0.0f : acc.getValue(o);
+      }
       float* dst = out.values.data() + std::size_t(out.brick[idx]) * kBrickVoxels;
-      const Tree::LeafNodeType* leaf = acc.probeConstLeaf(origin);
-      const float* src = leaf ? leaf->buffer().data() : nullptr;
       for (int x = 0; x < kBrickSide; ++x)
         for (int y = 0; y < kBrickSide; ++y)
           for (int z = 0; z < kBrickSide; ++z) {
-            const bool inside = src && x < kBlockSize && y < kBlockSize && z < kBlockSize;
-            const float v = inside ? src[(x << 6) | (y << 3) | z] : acc.getValue(origin.offsetBy(x, y, z));
+            const int c = (x >> kBlockLog2) << 2 | (y >> kBlockLog2) << 1 | (z >> kBlockLog2);
+            const float v = src[c] ? src[c][((x & 7) << 6) | ((y & 7) << 3) | (z & 7)] : tile[c];
             dst[(x * kBrickSide + y) * kBrickSide + z] = v;
             add(v);
           }
