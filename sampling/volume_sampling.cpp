@@ -9,6 +9,7 @@
 #include "core/errors.h"
 #include "core/timer.h"
 #include "mesh/mesh_analysis.h"
+#include "mesh/mesh_io.h"
 #include "mesh/mesh_prep.h"
 #include "volume/iso_values.h"
 #include "volume/marching_cubes.h"
@@ -107,15 +108,19 @@ ImageF frame_importance(const volume::RayCaster& caster, const FeatureGeometry* 
   return importance;
 }
 
-TraceBatch caster_trace_batch(const volume::RayCaster& caster) {
-  return [&caster](Span<const std::uint32_t> pixels, Span<Rgba> out) {
-    std::array<volume::RaySample, kRayGroup> samples;
+TraceBatch caster_trace_batch(const volume::RayCaster& caster, std::atomic<std::uint64_t>* samples) {
+  return [&caster, samples](Span<const std::uint32_t> pixels, Span<Rgba> out) {
+    std::array<volume::RaySample, kRayGroup> rays;
+    std::uint64_t taken = 0;
     for (std::size_t first = 0; first < pixels.size(); first += kRayGroup) {
       const std::size_t n = std::min(kRayGroup, pixels.size() - first);
-      caster.trace_pixels(Span<const std::uint32_t>(pixels.data() + first, n),
-                          Span<volume::RaySample>(samples.data(), n));
-      for (std::size_t i = 0; i < n; ++i) out[first + i] = samples[i].color;
+      caster.trace_pixels(Span<const std::uint32_t>(pixels.data() + first, n), Span<volume::RaySample>(rays.data(), n));
+      for (std::size_t i = 0; i < n; ++i) {
+        out[first + i] = rays[i].color;
+        taken += rays[i].samples;
+      }
     }
+    if (samples) samples->fetch_add(taken, std::memory_order_relaxed);
   };
 }
 
@@ -133,11 +138,83 @@ VolumeFrame render_volume_frame(const volume::RayCaster& caster, const FeatureGe
   VolumeFrame frame;
   const ImageF importance = frame_importance(caster, geometry, features);
   frame.importance_ms = total.elapsed_ms();
-  frame.sampled = render_sampled(importance, caster_trace_batch(caster), sampling, frame.importance_ms);
+  std::atomic<std::uint64_t> samples{0};
+  frame.sampled = render_sampled(importance, caster_trace_batch(caster, &samples), sampling, frame.importance_ms);
+  frame.samples = samples.load();
   frame.image = composite_frame(frame.sampled.image, caster.options().background);
   frame.sampled.image = ImageRGBA();
   frame.total_ms = total.elapsed_ms();
   return frame;
+}
+
+FeatureGeometry load_feature_geometry(const std::string& mesh_path) {
+  const Timer timer;
+  FeatureGeometry geometry;
+  geometry.mesh = mesh::read_mesh(mesh_path);
+  if (geometry.mesh.triangles.empty()) throw InvalidInput(file_message(mesh_path, "the feature mesh has no triangles"));
+  geometry.curvature = mesh::compute_curvature(geometry.mesh);
+  geometry.build_ms = timer.elapsed_ms();
+  return geometry;
+}
+
+SampledRender render_sampled_volume(const volume::Volume& volume, const volume::TransferFunction& tf,
+                                    const volume::RayCaster& caster, const SampledRenderRequest& request) {
+  validate(request.sampling);
+  if (request.progressive_frames < 0)
+    throw InvalidInput("--progressive must be >= 0, got " + std::to_string(request.progressive_frames));
+  const bool uses_features = request.sampling.mode == SamplingMode::Prioritized && !request.features.classes.is_empty();
+  FeatureGeometry geometry;
+  if (uses_features)
+    geometry = request.feature_mesh.empty() ? build_feature_geometry(volume, tf, request.geometry)
+                                            : load_feature_geometry(request.feature_mesh);
+  const FeatureGeometry* geometry_ptr = uses_features ? &geometry : nullptr;
+
+  SampledRender out;
+  Json& stats = out.stats;
+  stats["mode"] = sampling_mode_name(request.sampling.mode);
+  stats["features"] = uses_features ? Json("lines") : Json("none");
+  if (uses_features) {
+    stats["feature_triangles"] = geometry.mesh.triangles.size();
+    stats["iso_values"] = geometry.iso_values;
+  }
+  auto fill = [&](const SampledFrame& f, double importance_ms, double total_ms) {
+    stats["rays_traced"] = f.rays_traced;
+    stats["full_rays"] = f.full_rays;
+    stats["level0_rays"] = f.level0_rays;
+    stats["ray_fraction"] = f.full_rays ? double(f.rays_traced) / double(f.full_rays) : 0.0;
+    stats["times_ms"] = {{"importance", importance_ms}, {"priorities", f.priorities_ms}, {"trace", f.trace_ms},
+                         {"reconstruct", f.reconstruct_ms}, {"total", total_ms},
+                         {"features_setup", uses_features ? geometry.build_ms : 0.0}};
+    if (request.sampling.budget_ms > 0) {
+      stats["budget_ms"] = request.sampling.budget_ms;
+      stats["budget_too_small"] = f.budget_too_small;
+    }
+    out.budget_too_small = out.budget_too_small || f.budget_too_small;
+  };
+
+  if (request.progressive_frames == 0) {
+    VolumeFrame frame = render_volume_frame(caster, geometry_ptr, request.features, request.sampling);
+    fill(frame.sampled, frame.importance_ms, frame.total_ms);
+    out.image = std::move(frame.image);
+    return out;
+  }
+  const Timer first;
+  const ImageF importance = frame_importance(caster, geometry_ptr, request.features);
+  const double importance_ms = first.elapsed_ms();
+  SamplingOptions sampling = request.sampling;
+  ProgressiveSampler sampler(importance, sampling);
+  Json frames = Json::array();
+  SampledFrame frame;
+  for (int k = 0; k < request.progressive_frames && !(k > 0 && sampler.converged()); ++k) {
+    const Timer timer;
+    frame = sampler.next_frame(caster_trace_batch(caster));
+    const double ms = timer.elapsed_ms() + (k == 0 ? importance_ms : 0.0);
+    frames.push_back({{"rays_traced", frame.rays_traced}, {"total_ms", ms}, {"budget_too_small", frame.budget_too_small}});
+    fill(frame, k == 0 ? importance_ms : 0.0, ms);
+  }
+  stats["progressive"] = frames;
+  out.image = composite_frame(frame.image, caster.options().background);
+  return out;
 }
 
 }  // namespace raysift::sampling

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "core/json_io.h"
+
 #include "features/importance.h"
 #include "features/lines.h"
 #include "mesh/curvature.h"
@@ -55,8 +57,8 @@ features::LineClassSet parse_feature_list(const std::string& list);
 ImageF frame_importance(const volume::RayCaster& caster, const FeatureGeometry* geometry,
                         const FeatureOptions& options);
 
-/// The caster as a batch tracer for the scheduler.
-TraceBatch caster_trace_batch(const volume::RayCaster& caster);
+/// The caster as a batch tracer for the scheduler; adds the volume samples taken to `samples` if given.
+TraceBatch caster_trace_batch(const volume::RayCaster& caster, std::atomic<std::uint64_t>* samples = nullptr);
 
 /// A composited volume frame and its per-stage times.
 struct VolumeFrame {
@@ -64,6 +66,7 @@ struct VolumeFrame {
   SampledFrame sampled;   ///< counts, masks and times (its image is moved into `image` and composited)
   double importance_ms = 0;
   double total_ms = 0;    ///< importance + priorities + trace + reconstruct (wall)
+  std::uint64_t samples = 0;  ///< volume samples taken by the traced rays
 };
 
 /// \brief Renders one frame with the given sampling mode.
@@ -73,5 +76,33 @@ VolumeFrame render_volume_frame(const volume::RayCaster& caster, const FeatureGe
 
 /// Composites a premultiplied frame over `background` with the caster's shared rule.
 ImageRGBA composite_frame(const ImageRGBA& premultiplied, const Vec3f& background);
+
+/// \brief Feature geometry from a prepared mesh file (e.g. the output of `raysift mesh`) instead of the
+/// volume's iso-surfaces. \throw IoError / InvalidInput naming the file.
+FeatureGeometry load_feature_geometry(const std::string& mesh_path);
+
+/// What `raysift render --mode prioritized|subsample` asks for.
+struct SampledRenderRequest {
+  SamplingOptions sampling;
+  FeatureOptions features;              ///< classes empty = the control (no feature geometry is built)
+  FeatureGeometryOptions geometry;
+  std::string feature_mesh;             ///< non-empty: load the feature mesh instead of extracting it
+  int progressive_frames = 0;           ///< > 0: that many progressive frames, the last one is returned
+};
+
+/// The final composited image and the stats keys mode, rays_traced, full_rays, level0_rays, ray_fraction,
+/// times_ms {importance, priorities, trace, reconstruct, total, features_setup} (total = the frame:
+/// importance + priorities + trace + reconstruct; features_setup is view-independent and excluded),
+/// and, when used, budget_ms, budget_too_small, feature_triangles, iso_values, progressive (per frame).
+struct SampledRender {
+  ImageRGBA image;
+  Json stats;
+  bool budget_too_small = false;
+};
+
+/// \throw InvalidInput for invalid options (see validate()), a progressive request outside the
+///        prioritized mode, or feature geometry that cannot be built.
+SampledRender render_sampled_volume(const volume::Volume& volume, const volume::TransferFunction& tf,
+                                    const volume::RayCaster& caster, const SampledRenderRequest& request);
 
 }  // namespace raysift::sampling
