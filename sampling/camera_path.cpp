@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/file_util.h"
 #include "core/timer.h"
 #include "features/warp.h"
 #include "sampling/frame_rate.h"
@@ -140,9 +141,8 @@ double mean_ssim(const ImageRGBA& reference, const ImageRGBA& test) {
   return n > 0 ? sum / double(n) : std::numeric_limits<double>::quiet_NaN();
 }
 
-/// Priority units added to α00 per frame while the camera stands still and no frame rate is targeted
-/// ([choice]; the RP paper only says α00 is increased): ten frames take the default mapping from level 0
-/// to every ray.
+/// Priority units added to α00 per still frame in threshold mode without a frame-rate target ([choice];
+/// the RP paper only says α00 is increased): a few frames take the default mapping to every ray.
 constexpr float kRefineStep = 0.2f;
 
 }  // namespace
@@ -310,9 +310,6 @@ std::vector<PathFrame> render_camera_path(const volume::Volume& volume, const vo
     fo.initial_alpha00 = options.sampling.mapping.alpha[0];
     controller.emplace(fo);  // validates target_fps
   }
-  // A still camera refines in threshold mode (α00 grows), so it needs a threshold even without a target.
-  const float threshold = controller ? controller->threshold()
-                                     : (std::isfinite(options.sampling.threshold) ? options.sampling.threshold : 1.0f);
 
   std::vector<PathFrame> frames;
   std::optional<PreviousFrame> previous;
@@ -320,6 +317,7 @@ std::vector<PathFrame> render_camera_path(const volume::Volume& volume, const vo
   std::unique_ptr<FractalPattern> pattern;
   ImageF still_importance;  // importance of the first frame since the camera stopped
   float alpha00 = options.sampling.mapping.alpha[0];
+  int still_frames = 0;  // frames since the camera stopped, after the first
   FrameTiming last_timing;
   for (std::size_t i = 0; i < cameras.size(); ++i) {
     const CameraSpec& spec = cameras[i];
@@ -329,6 +327,7 @@ std::vector<PathFrame> render_camera_path(const volume::Volume& volume, const vo
     PathFrame frame;
     frame.index = int(i);
     frame.refined = previous.has_value() && same_camera(previous->camera, spec);
+    still_frames = frame.refined ? still_frames + 1 : 0;
     ImageRGBA image;
     const Timer clock;
     if (mode == SamplingMode::Full) {
@@ -355,15 +354,19 @@ std::vector<PathFrame> render_camera_path(const volume::Volume& volume, const vo
       if (mode == SamplingMode::Prioritized) {
         if (controller) {
           if (!frames.empty())
-            alpha00 = controller->update(last_timing, RayCountCurve(still_importance, *pattern, so.mapping, threshold),
+            alpha00 = controller->update(last_timing,
+                                         RayCountCurve(still_importance, *pattern, so.mapping, controller->threshold()),
                                          frame.refined ? cache->traced : 0);
           if (frame.refined) alpha00 = std::max(alpha00, frames.back().alpha00);
-        } else if (frame.refined) {
-          alpha00 = frames.back().alpha00 + kRefineStep;
-        }
-        if (controller || frame.refined) {
-          so.threshold = threshold;
+          so.threshold = controller->threshold();
           so.mapping.alpha[0] = alpha00;
+        } else if (frame.refined) {
+          // Refinement keeps the frame's own selection rule, so every still frame selects a superset of
+          // the one before: a threshold frame raises α00, a fraction frame adds another fraction.
+          if (std::isfinite(so.threshold))
+            so.mapping.alpha[0] = alpha00 = frames.back().alpha00 + kRefineStep;
+          else
+            so.ray_fraction = std::min(1.0, so.ray_fraction * double(still_frames + 1));
         }
         frame.alpha00 = so.mapping.alpha[0];
       }
@@ -386,6 +389,48 @@ std::vector<PathFrame> render_camera_path(const volume::Volume& volume, const vo
     previous->depth = cache->depth;
   }
   return frames;
+}
+
+std::string split_saliency_feature(const std::string& list, bool& has_saliency) {
+  has_saliency = false;
+  std::string rest;
+  std::stringstream items(list);
+  std::string item;
+  while (std::getline(items, item, ',')) {
+    if (item == "saliency") {
+      has_saliency = true;
+    } else if (!item.empty() && item != "none") {
+      rest += (rest.empty() ? "" : ",") + item;
+    }
+  }
+  return rest.empty() ? "none" : rest;
+}
+
+Json run_path_request(const volume::Volume& volume, const volume::TransferFunction& tf,
+                      const volume::RenderOptions& render, const CameraSpec& camera, const PathRenderRequest& request) {
+  if (!is_frame_pattern(request.out_pattern))
+    throw InvalidInput("-o/--out must be a frame pattern with one integer conversion such as frame_%03d.png when "
+                       "rendering a camera path, got '" + request.out_pattern + "'");
+  const Timer total;
+  const std::vector<CameraSpec> cameras = load_camera_path(request.camera_path, camera);
+  const Timer setup;
+  std::optional<FeatureGeometry> geometry;
+  if (!request.options.features.lines.classes.is_empty()) geometry = build_feature_geometry(volume, tf, request.geometry);
+  const double setup_ms = setup.elapsed_ms();
+  const auto frames = render_camera_path(volume, tf, render, cameras, geometry ? &*geometry : nullptr, request.options,
+                                         [&](const PathFrame& frame, const ImageRGBA& image) {
+                                           const std::string name = frame_file_name(request.out_pattern, frame.index);
+                                           if (file_extension(name) != ".png") return write_image(name, image);
+                                           ImageRGBA opaque = image;  // composited colour: show it opaque, as render does
+                                           for (Rgba& p : opaque.pixels) p.a = 1.0f;
+                                           write_image(name, opaque);
+                                         });
+  Json stats = path_stats_json(frames, request.options.target_fps);
+  stats["camera_path"] = request.camera_path;
+  stats["frame_files"] = {frame_file_name(request.out_pattern, 0),
+                          frame_file_name(request.out_pattern, int(frames.size()) - 1)};
+  stats["times_ms"] = {{"features_setup", setup_ms}, {"total", total.elapsed_ms()}};
+  return stats;
 }
 
 Json path_stats_json(const std::vector<PathFrame>& frames, double target_fps) {

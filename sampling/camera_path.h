@@ -110,6 +110,26 @@ std::vector<PathFrame> render_camera_path(const volume::Volume& volume, const vo
                                           const FeatureGeometry* geometry, const PathRenderOptions& options,
                                           const PathFrameSink& sink);
 
+/// \brief Splits a `--features` list into the line-class list and the image-space feature: removes the
+/// entry "saliency" (setting `has_saliency`) and returns the rest, "none" when nothing is left.
+std::string split_saliency_feature(const std::string& list, bool& has_saliency);
+
+/// What `raysift render --camera-path` asks for (the app fills it from its flags).
+struct PathRenderRequest {
+  std::string camera_path;            ///< JSON file (see camera_path_from_json)
+  std::string out_pattern;            ///< printf pattern with one integer conversion, e.g. frame_%03d.png
+  PathRenderOptions options;
+  FeatureGeometryOptions geometry;    ///< used when line classes are enabled
+};
+
+/// \brief Loads the path (missing orbit fields from `camera`), builds the feature geometry when line
+/// classes are enabled, renders every frame and writes it to out_pattern formatted with its index.
+/// \return path_stats_json plus "camera_path", "frame_files" (first and last name) and "times_ms"
+///         {"features_setup", "total"}.
+/// \throw InvalidInput / IoError naming the file or flag at fault.
+Json run_path_request(const volume::Volume& volume, const volume::TransferFunction& tf,
+                      const volume::RenderOptions& render, const CameraSpec& camera, const PathRenderRequest& request);
+
 /// The stats of a path: {"frames": [{"index", "ms", "rays_traced", "full_rays", "alpha00", "refined",
 /// "saliency_ms", "ssim_vs_full" (null without compare)}], "target_ms" (when set), "within_10pct_of_target"
 /// (share of frames with ms <= 1.1 target), "mean_ssim_vs_full" (when compared)}.

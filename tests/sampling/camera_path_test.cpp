@@ -148,30 +148,38 @@ TEST(PathImportance, SaliencyOffIsTheLineImportanceBitForBitAndRunsNoSaliency) {
   EXPECT_EQ(path_frame_importance(caster, nullptr, on, nullptr, 8, &saliency_ms).pixels, line_only.pixels);
 }
 
-TEST(RenderCameraPath, StillCameraReusesRaysAndConvergesToTheFullRender) {
+class StillCamera : public ::testing::TestWithParam<bool> {};
+
+TEST_P(StillCamera, ReusesRaysAndConvergesToTheFullRender) {
+  // Fraction mode adds 10 % per still frame; threshold mode raises alpha00 by 0.2 per frame.
+  const bool threshold_mode = GetParam();
   const PathScene scene;
-  const std::vector<CameraSpec> cams(6, scene.camera(10));
+  const std::vector<CameraSpec> cams(10, scene.camera(10));
   PathRenderOptions opt;
   opt.sampling.mode = SamplingMode::Prioritized;
   opt.sampling.ray_fraction = 0.1;
+  if (threshold_mode) opt.sampling.threshold = 1.0f;
   std::vector<ImageRGBA> images;
   const auto frames = render_camera_path(scene.vol, scene.tf, {}, cams, nullptr, opt,
                                          [&](const PathFrame&, const ImageRGBA& img) { images.push_back(img); });
-  ASSERT_EQ(frames.size(), 6u);
+  ASSERT_EQ(frames.size(), cams.size());
   std::size_t total = 0;
   for (std::size_t i = 0; i < frames.size(); ++i) {
     EXPECT_EQ(frames[i].refined, i > 0);
-    if (i > 1) {
-      EXPECT_GT(frames[i].alpha00, frames[i - 1].alpha00);
+    if (threshold_mode && i > 0) {
+      EXPECT_FLOAT_EQ(frames[i].alpha00, frames[i - 1].alpha00 + 0.2f);
     }
     total += frames[i].rays_traced;
   }
+  EXPECT_GT(frames[1].rays_traced, 0u);
   // Every object ray is traced exactly once over the path, and the last frame is the full render.
   EXPECT_EQ(total, frames.back().full_rays);
   const volume::RayCaster caster(scene.vol, scene.tf, cams.back());
   EXPECT_EQ(images.back().pixels, volume::render_full(caster).image.pixels);
-  EXPECT_LT(frames[0].rays_traced, frames[0].full_rays / 5);
+  EXPECT_LT(frames[0].rays_traced, frames[0].full_rays / 2);
 }
+
+INSTANTIATE_TEST_SUITE_P(SelectionRules, StillCamera, ::testing::Values(false, true));
 
 TEST(RenderCameraPath, FullModeOnAnOrbitMatchesSingleRenders) {
   const PathScene scene;
