@@ -190,6 +190,21 @@ TEST(Metrics, PixelRedundancyConvergesToVisibilityWithResolution) {
   EXPECT_GT(gap_256, 0.0);
 }
 
+TEST(Metrics, SingleViewIsOneConventionalImageWithEverythingAvailable) {
+  const SampledScene scene(small_grass().mesh);
+  const std::vector<CameraSpec> views = sized({small_grass().views.views[0]}, 48);
+  const auto frames = intermediate_views(Span<const CameraSpec>(views), 100);
+  ASSERT_EQ(frames.size(), 1u);  // a point region: the view itself, once
+  const auto conv = render(scene, views, SamplingMode::Conventional);
+  for (SamplingMode mode : {SamplingMode::NrrPixel, SamplingMode::NrrVisibility}) {
+    const auto nrr = render(scene, views, mode);
+    EXPECT_EQ(nrr[0].triangle_id, conv[0].triangle_id);
+    const SamplingMetrics m = metrics(scene, mode, views, nrr, conv, frames, Redundancy::Pixel);
+    EXPECT_EQ(m.images[0].disoccluded, 0u);
+    EXPECT_EQ(m.available_min_pct, 100.0);  // the frame is the reference image itself
+  }
+}
+
 TEST(Metrics, BadInputThrows) {
   const SampledScene scene(small_grass().mesh);
   const auto views = sized(small_grass().views.views, 16);
