@@ -7,6 +7,8 @@
 #include <limits>
 
 #include "core/errors.h"
+#include "core/image.h"
+#include "tests/support/test_support.h"
 #include "volume/generate.h"
 #include "volume/raycaster.h"
 
@@ -199,6 +201,41 @@ TEST(RenderCameraPath, FullModeOnAnOrbitMatchesSingleRenders) {
   const Json stats = path_stats_json(frames, 0);
   EXPECT_EQ(stats.at("frames").size(), 3u);
   EXPECT_EQ(stats.at("mean_ssim_vs_full"), 1.0);
+}
+
+TEST(RenderCameraPath, RequestWritesEveryFrameAndItsStats) {
+  const PathScene scene;
+  const std::string dir = test::make_temp_dir("camera_path_request");
+  write_json_file(dir + "/orbit.json",
+                  Json::parse(R"({"orbit": {"centre": [15.5, 15.5, 15.5], "radius": 60, "elevation_deg": 20,
+                                            "frames": 3, "width": 40, "height": 32}})"));
+  PathRenderRequest req;
+  req.camera_path = dir + "/orbit.json";
+  req.out_pattern = dir + "/f_%02d.exr";
+  req.options.sampling.mode = SamplingMode::Prioritized;
+  req.options.sampling.ray_fraction = 0.3;
+  const Json stats = run_path_request(scene.vol, scene.tf, {}, scene.camera(0), req);
+  for (int i = 0; i < 3; ++i) {
+    const ImageRGBA img = read_image_rgba(frame_file_name(req.out_pattern, i));
+    EXPECT_EQ(img.width, 40);
+    EXPECT_EQ(img.height, 32);
+  }
+  ASSERT_EQ(stats.at("frames").size(), 3u);
+  EXPECT_EQ(stats.at("frame_files").at(1), dir + "/f_02.exr");
+  EXPECT_TRUE(stats.at("frames").at(2).at("ssim_vs_full").is_null());
+  EXPECT_GT(stats.at("frames").at(2).at("rays_traced").get<std::size_t>(), 0u);
+  req.out_pattern = dir + "/single.exr";
+  EXPECT_THROW(run_path_request(scene.vol, scene.tf, {}, scene.camera(0), req), InvalidInput);
+}
+
+TEST(RenderCameraPath, SplitsSaliencyFromTheFeatureList) {
+  bool has = false;
+  EXPECT_EQ(split_saliency_feature("contours,saliency,ridges", has), "contours,ridges");
+  EXPECT_TRUE(has);
+  EXPECT_EQ(split_saliency_feature("saliency", has), "none");
+  EXPECT_TRUE(has);
+  EXPECT_EQ(split_saliency_feature("contours,silhouettes", has), "contours,silhouettes");
+  EXPECT_FALSE(has);
 }
 
 TEST(RenderCameraPath, RejectsBadRequests) {
