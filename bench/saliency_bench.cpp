@@ -80,8 +80,10 @@ void run_orbit(const volume::Volume& vol, const volume::TransferFunction& tf, co
     double ms = 0, rays = 0, saliency = 0;
     for (const sampling::PathFrame& f : path) {
       if (per_frame)
-        std::printf("  frame %2d: %8.1f ms (saliency %5.1f), rays %7zu / %7zu, alpha00 %+.4f, SSIM %.4f\n", f.index,
-                    f.ms, f.saliency_ms, f.rays_traced, f.full_rays, double(f.alpha00), f.ssim_vs_full);
+        std::printf("  frame %2d: %7.1f ms (importance %6.1f incl. saliency %5.1f, trace %6.1f), rays %7zu / %7zu, "
+                    "alpha00 %+.4f, SSIM %.4f\n",
+                    f.index, f.ms, f.importance_ms, f.saliency_ms, f.trace_ms, f.rays_traced, f.full_rays,
+                    double(f.alpha00), f.ssim_vs_full);
       ms += f.ms;
       rays += double(f.rays_traced) / double(std::max<std::size_t>(f.full_rays, 1));
       saliency += f.saliency_ms;

@@ -337,6 +337,7 @@ std::vector<PathFrame> render_camera_path(const volume::Volume& volume, const vo
         volume::RenderResult r = volume::render_full(caster);
         image = std::move(r.image);
         frame.rays_traced = std::size_t(r.rays_traced);
+        frame.trace_ms = clock.elapsed_ms();
         cache = std::make_unique<RayCache>(w, h);
         cache->depth = std::move(r.depth);
       }
@@ -349,6 +350,7 @@ std::vector<PathFrame> render_camera_path(const volume::Volume& volume, const vo
         still_importance = path_frame_importance(caster, geometry, options.features,
                                                  previous ? &*previous : nullptr, options.sampling.base_spacing,
                                                  &frame.saliency_ms);
+        frame.importance_ms = clock.elapsed_ms();
       }
       SamplingOptions so = options.sampling;
       if (mode == SamplingMode::Prioritized) {
@@ -376,6 +378,7 @@ std::vector<PathFrame> render_camera_path(const volume::Volume& volume, const vo
       cache->traced += new_rays;
       frame.rays_traced = new_rays;
       frame.full_rays = s.full_rays;
+      frame.trace_ms = s.trace_ms;
       image = composite_frame(s.image, caster.options().background);
       last_timing = {0, s.trace_ms, new_rays};
     }
@@ -439,9 +442,15 @@ Json path_stats_json(const std::vector<PathFrame>& frames, double target_fps) {
   std::size_t ssim_n = 0, within = 0;
   const double target_ms = target_fps > 0 ? 1000.0 / target_fps : 0;
   for (const PathFrame& f : frames) {
-    Json j = {{"index", f.index},           {"ms", f.ms},           {"rays_traced", f.rays_traced},
-              {"full_rays", f.full_rays},   {"alpha00", f.alpha00}, {"refined", f.refined},
-              {"saliency_ms", f.saliency_ms}};
+    Json j = {{"index", f.index},
+              {"ms", f.ms},
+              {"importance_ms", f.importance_ms},
+              {"saliency_ms", f.saliency_ms},
+              {"trace_ms", f.trace_ms},
+              {"rays_traced", f.rays_traced},
+              {"full_rays", f.full_rays},
+              {"alpha00", f.alpha00},
+              {"refined", f.refined}};
     j["ssim_vs_full"] = std::isfinite(f.ssim_vs_full) ? Json(f.ssim_vs_full) : Json(nullptr);
     if (std::isfinite(f.ssim_vs_full)) {
       ssim_sum += f.ssim_vs_full;

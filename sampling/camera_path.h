@@ -90,7 +90,9 @@ struct PathRenderOptions {
 struct PathFrame {
   int index = 0;
   double ms = 0;                ///< wall time: importance (+ saliency), priorities, trace, reconstruction
-  double saliency_ms = 0;
+  double importance_ms = 0;     ///< lines + background + saliency (included in ms)
+  double saliency_ms = 0;       ///< saliency + warp (included in importance_ms)
+  double trace_ms = 0;          ///< tracing alone (included in ms)
   std::size_t rays_traced = 0;
   std::size_t full_rays = 0;    ///< rays of the full render of this view
   float alpha00 = 0;            ///< α00 used (target-fps: the controller's choice)
@@ -130,8 +132,8 @@ struct PathRenderRequest {
 Json run_path_request(const volume::Volume& volume, const volume::TransferFunction& tf,
                       const volume::RenderOptions& render, const CameraSpec& camera, const PathRenderRequest& request);
 
-/// The stats of a path: {"frames": [{"index", "ms", "rays_traced", "full_rays", "alpha00", "refined",
-/// "saliency_ms", "ssim_vs_full" (null without compare)}], "target_ms" (when set), "within_10pct_of_target"
+/// The stats of a path: {"frames": [{"index", "ms", "importance_ms", "saliency_ms", "trace_ms",
+/// "rays_traced", "full_rays", "alpha00", "refined", "ssim_vs_full" (null without compare)}], "target_ms" (when set), "within_10pct_of_target"
 /// (share of frames with ms <= 1.1 target), "mean_ssim_vs_full" (when compared)}.
 Json path_stats_json(const std::vector<PathFrame>& frames, double target_fps);
 
