@@ -1,7 +1,6 @@
 #include "mesh/mesh_io.h"
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
-#include <OpenMesh/Core/System/omstream.hh>
 
 #include <cmath>
 
@@ -18,24 +17,6 @@ void require_mesh_extension(const std::string& path) {
   if (ext != ".ply" && ext != ".obj" && ext != ".off")
     throw IoError(file_message(path, "unsupported mesh format '" + ext + "'; expected .ply, .obj or .off"));
 }
-
-/// OpenMesh reports parse problems on its own streams; library code must not print (STYLE.md §5),
-/// so they are muted while reading and the outcome is reported through exceptions instead.
-class MuteOpenMeshLog {
- public:
-  MuteOpenMeshLog() {
-    omerr().disable();
-    omlog().disable();
-    omout().disable();
-  }
-  ~MuteOpenMeshLog() {
-    omerr().enable();
-    omlog().enable();
-    omout().enable();
-  }
-  MuteOpenMeshLog(const MuteOpenMeshLog&) = delete;
-  MuteOpenMeshLog& operator=(const MuteOpenMeshLog&) = delete;
-};
 
 }  // namespace
 
@@ -56,7 +37,7 @@ TriMesh read_mesh(const std::string& path, const MeshReadOptions& options) {
   require_mesh_extension(path);
   detail::OmPolyMesh poly;
   {
-    MuteOpenMeshLog mute;
+    detail::MuteOpenMeshLog mute;
     if (!OpenMesh::IO::read_mesh(poly, path))
       throw IoError(file_message(path, "could not parse the mesh (malformed or truncated file)"));
   }
@@ -89,6 +70,7 @@ void write_mesh(const std::string& path, const TriMesh& mesh, const MeshWriteOpt
   validate_mesh(mesh, path);
   // OpenMesh's halfedge kernel cannot hold a face that would make an edge or vertex non-manifold;
   // such a face gets its own copies of its three vertices (OpenMesh's importer does the same).
+  detail::MuteOpenMeshLog mute;  // add_face reports refused (non-manifold) faces on omerr; they are handled below
   detail::OmPolyMesh om;
   om.reserve(mesh.positions.size(), mesh.triangles.size() * 3 / 2, mesh.triangles.size());
   for (const Vec3f& p : mesh.positions) om.add_vertex({p.x, p.y, p.z});
@@ -103,7 +85,6 @@ void write_mesh(const std::string& path, const TriMesh& mesh, const MeshWriteOpt
   OpenMesh::IO::Options opt;
   if (options.binary && file_extension(path) == ".ply") opt += OpenMesh::IO::Options::Binary;
   write_atomically(path, [&](const std::string& tmp) {
-    MuteOpenMeshLog mute;
     if (!OpenMesh::IO::write_mesh(om, tmp, opt, 9)) throw IoError(file_message(path, "writing the mesh failed"));
   });
 }

@@ -9,6 +9,7 @@ OmTriMesh to_openmesh(const TriMesh& mesh, std::size_t* rejected_faces) {
   om.reserve(mesh.positions.size(), mesh.triangles.size() * 3 / 2, mesh.triangles.size());
   for (const Vec3f& p : mesh.positions) om.add_vertex(OmTriMesh::Point(p.x, p.y, p.z));
   std::size_t rejected = 0;
+  MuteOpenMeshLog mute;
   for (const auto& t : mesh.triangles) {
     const auto f = om.add_face(OmTriMesh::VertexHandle(int(t[0])), OmTriMesh::VertexHandle(int(t[1])),
                                OmTriMesh::VertexHandle(int(t[2])));

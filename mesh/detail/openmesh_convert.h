@@ -3,6 +3,7 @@
 /// plain TriMesh. Heavy header: include only from mesh/*.cpp.
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#include <OpenMesh/Core/System/omstream.hh>
 
 #include "mesh/tri_mesh.h"
 
@@ -17,6 +18,25 @@ struct OmTraits : OpenMesh::DefaultTraits {
 };
 using OmTriMesh = OpenMesh::TriMesh_ArrayKernelT<OmTraits>;
 using OmPolyMesh = OpenMesh::PolyMesh_ArrayKernelT<>;
+
+/// OpenMesh reports refused faces and parse problems on its own streams; library code must not print
+/// (STYLE.md §5), so they are muted in this scope and outcomes are reported through exceptions instead.
+/// Not thread-safe (OpenMesh's streams are global).
+class MuteOpenMeshLog {
+ public:
+  MuteOpenMeshLog() {
+    omerr().disable();
+    omlog().disable();
+    omout().disable();
+  }
+  ~MuteOpenMeshLog() {
+    omerr().enable();
+    omlog().enable();
+    omout().enable();
+  }
+  MuteOpenMeshLog(const MuteOpenMeshLog&) = delete;
+  MuteOpenMeshLog& operator=(const MuteOpenMeshLog&) = delete;
+};
 
 /// Every TriMesh vertex becomes an OpenMesh vertex with the same index. OpenMesh refuses faces that
 /// would make an edge or vertex non-manifold; those are skipped and counted in `rejected_faces`.

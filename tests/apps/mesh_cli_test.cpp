@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <sstream>
 
 #include "core/json_io.h"
@@ -78,20 +79,29 @@ TEST_F(MeshCli, BadInputFailsWithoutOutput) {
     std::string message;
   };
   const Case cases[] = {
-      {"mesh ball.vdb --tf zero.json -o a.ply", 1, "opacity is zero"},
-      {"mesh ball.vdb --iso 7 -o b.ply", 2, "--iso must be within the data range"},
-      {"mesh empty.vdb --iso 0.5 -o c.ply", 1, "no active voxels"},
-      {"mesh ball.vdb --iso 0.5 --decimate 0 -o d.ply", 2, "--decimate"},
-      {"mesh ball.vdb --iso 0.5 --smooth -1 -o e.ply", 2, "--smooth"},
-      {"mesh ball.vdb --iso 0.5 --decimate 0.5 --faces 100 -o f.ply", 2, "exclusive"},
+      {"mesh ../ball.vdb --tf ../zero.json -o a.ply", 1, "opacity is zero"},
+      {"mesh ../ball.vdb --iso 7 -o b.ply", 2, "--iso must be within the data range"},
+      {"mesh ../empty.vdb --iso 0.5 -o c.ply", 1, "no active voxels"},
+      {"mesh ../ball.vdb --iso 0.5 --decimate 0 -o d.ply", 2, "--decimate"},
+      {"mesh ../ball.vdb --iso 0.5 --smooth -1 -o e.ply", 2, "--smooth"},
+      {"mesh ../ball.vdb --iso 0.5 --decimate 0.5 --faces 100 -o f.ply", 2, "exclusive"},
   };
-  for (const Case& c : cases) {
-    const CliResult r = run_raysift(dir_, c.args);
+  // Independent runs in parallel (process start-up dominates), each in its own folder for its captured output.
+  std::vector<std::future<CliResult>> runs;
+  for (std::size_t i = 0; i < std::size(cases); ++i) {
+    const std::string sub = dir_ + "/case" + std::to_string(i);
+    std::filesystem::create_directories(sub);
+    runs.push_back(std::async(std::launch::async, [sub, args = cases[i].args] { return run_raysift(sub, args); }));
+  }
+  for (std::size_t i = 0; i < std::size(cases); ++i) {
+    const CliResult r = runs[i].get();
+    const Case& c = cases[i];
     EXPECT_EQ(r.code, c.code) << c.args << "\n" << r.err;
     EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << "\n" << r.err;
   }
-  for (const char* name : {"a.ply", "b.ply", "c.ply", "d.ply", "e.ply", "f.ply"})
-    EXPECT_FALSE(std::filesystem::exists(dir_ + "/" + name)) << name;
+  for (std::size_t i = 0; i < std::size(cases); ++i)
+    for (const char* name : {"a.ply", "b.ply", "c.ply", "d.ply", "e.ply", "f.ply"})
+      EXPECT_FALSE(std::filesystem::exists(dir_ + "/case" + std::to_string(i) + "/" + name)) << name;
 }
 
 }  // namespace
