@@ -70,8 +70,11 @@ SamplingMetrics compute_sampling_metrics(const SampledScene& scene, SamplingMode
   std::vector<Camera> ref_cameras, conv_cameras;
   for (const DepthImage& im : reference) ref_cameras.emplace_back(im.camera);
   for (const DepthImage& im : conventional) conv_cameras.emplace_back(im.camera);
-  const auto captured = [&](const DepthImage& image, const Camera& camera, const Vec3f& x, mesh::TriangleId id) {
-    return by_pixel ? detail::pixel_captured(image, camera, x, id) : detail::visible_from(scene, camera, x, id);
+  const std::vector<detail::PixelProjector> ref_projectors(ref_cameras.begin(), ref_cameras.end());
+  const std::vector<detail::PixelProjector> conv_projectors(conv_cameras.begin(), conv_cameras.end());
+  const auto captured = [&](const DepthImage& image, const Camera& camera, const detail::PixelProjector& projector,
+                            const Vec3f& x, mesh::TriangleId id) {
+    return by_pixel ? detail::pixel_captured(image, projector, x, id) : detail::visible_from(scene, camera, x, id);
   };
 
   SamplingMetrics m;
@@ -88,7 +91,8 @@ SamplingMetrics compute_sampling_metrics(const SampledScene& scene, SamplingMode
     m.images[i].redundant = count_if_index(im.pixel_count(), threaded, [&](std::size_t p) {
       if (!im.has_sample(p)) return false;
       for (std::size_t j = 0; j < i; ++j)
-        if (captured(reference[j], ref_cameras[j], im.position_ws[p], im.triangle_id[p])) return true;
+        if (captured(reference[j], ref_cameras[j], ref_projectors[j], im.position_ws[p], im.triangle_id[p]))
+          return true;
       return false;
     });
     if (mode == SamplingMode::Conventional) continue;  // (2) is 0 for conventional images by definition
@@ -102,7 +106,8 @@ SamplingMetrics compute_sampling_metrics(const SampledScene& scene, SamplingMode
         // directly (also right for hits at t = 0, which cannot be projected).
         const bool is_same_view = by_pixel && j == i && mode != SamplingMode::Peel;
         if (is_same_view ? conventional[j].triangle_id[p] == im.triangle_id[p]
-                         : captured(conventional[j], conv_cameras[j], im.position_ws[p], im.triangle_id[p]))
+                         : captured(conventional[j], conv_cameras[j], conv_projectors[j], im.position_ws[p],
+                                    im.triangle_id[p]))
           return false;
       }
       cls[p] = SampleClass::Disoccluded;
@@ -127,7 +132,7 @@ SamplingMetrics compute_sampling_metrics(const SampledScene& scene, SamplingMode
     }
     for (std::size_t i = 0; i < n; ++i) {
       if (by_pixel) {
-        if (detail::pixel_captured(reference[i], ref_cameras[i], x, id)) return true;
+        if (detail::pixel_captured(reference[i], ref_projectors[i], x, id)) return true;
         continue;
       }
       const Camera& cam = ref_cameras[i];
@@ -149,6 +154,7 @@ SamplingMetrics compute_sampling_metrics(const SampledScene& scene, SamplingMode
     conv.threaded = threaded;
     const DepthImage frame = std::move(render_depth_images(scene, Span<const CameraSpec>(&spec, 1), conv)[0]);
     const Camera frame_camera(frame.camera);
+    const detail::PixelProjector frame_projector(frame_camera);
     const std::size_t samples = frame.sample_count();
     if (samples > 0) {
       const std::size_t available = count_if_index(frame.pixel_count(), threaded, [&](std::size_t p) {
@@ -163,7 +169,8 @@ SamplingMetrics compute_sampling_metrics(const SampledScene& scene, SamplingMode
     count_if_index(disoccluded.size(), threaded, [&](std::size_t k) {
       const auto [i, p] = disoccluded[k];
       if (m.sample_classes[i][p] == SampleClass::Useful) return false;
-      if (!captured(frame, frame_camera, reference[i].position_ws[p], reference[i].triangle_id[p])) return false;
+      if (!captured(frame, frame_camera, frame_projector, reference[i].position_ws[p], reference[i].triangle_id[p]))
+        return false;
       m.sample_classes[i][p] = SampleClass::Useful;
       return true;
     });

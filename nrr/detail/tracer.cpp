@@ -58,11 +58,19 @@ void insert_distinct(std::vector<Candidate>& list, const Candidate& c, std::size
 
 }  // namespace
 
-bool pixel_captured(const DepthImage& image, const Camera& camera, const Vec3f& x, mesh::TriangleId id) {
-  const auto p = camera.project(Vec3d(x));
-  if (!p || !(p->x_ss >= 0.0 && p->x_ss < image.width && p->y_ss >= 0.0 && p->y_ss < image.height)) return false;
-  const std::size_t pixel = std::size_t(p->y_ss) * std::size_t(image.width) + std::size_t(p->x_ss);
-  return image.triangle_id[pixel] == id;
+PixelProjector::PixelProjector(const Camera& camera)
+    : eye_(camera.eye()), forward_(camera.forward()), width_(camera.width()), height_(camera.height()) {
+  const double tan_half_y = std::tan(camera.spec().fov_y_deg * M_PI / 360.0);
+  const double tan_half_x = tan_half_y * double(width_) / double(height_);
+  half_w_ = 0.5 * width_;
+  half_h_ = 0.5 * height_;
+  right_ = camera.right() * (half_w_ / tan_half_x);
+  down_ = camera.image_up() * (-half_h_ / tan_half_y);
+}
+
+bool pixel_captured(const DepthImage& image, const PixelProjector& projector, const Vec3f& x, mesh::TriangleId id) {
+  const std::ptrdiff_t pixel = projector.pixel(x);
+  return pixel >= 0 && image.triangle_id[std::size_t(pixel)] == id;
 }
 
 bool may_be_visible_from(const SampledScene& scene, const Camera& camera, const Vec3f& x, mesh::TriangleId id) {
@@ -95,10 +103,11 @@ void trace(const SampledScene& scene, const ImageRule& rule, Span<const mesh::Ra
         scene.rays().intersect(rays, hits, options);
         return;
       }
+      const std::vector<PixelProjector> projectors(rule.previous_cameras.begin(), rule.previous_cameras.end());
       const mesh::HitFilter keep_non_redundant = [&](const mesh::HitCandidate& c) {
         const Vec3f x = sample_position(rays[c.ray_index], c.t);
         for (std::size_t j = 0; j < rule.previous.size(); ++j)
-          if (pixel_captured(rule.previous[j], rule.previous_cameras[j], x, c.triangle_id)) return false;
+          if (pixel_captured(rule.previous[j], projectors[j], x, c.triangle_id)) return false;
         return true;
       };
       // The filter is pure, but QueryOptions::is_filter_pure stays off: redundancy rejects 15-50 % of

@@ -15,8 +15,32 @@ inline Vec3f sample_position(const mesh::RayF& ray, float t) {
   return Vec3f(Vec3d(ray.origin) + Vec3d(ray.direction) * double(t));
 }
 
+/// Projection of world points to pixel indices of one camera, with the camera basis pre-scaled so a
+/// point costs three dot products and one division (the pixel-redundancy filter runs per candidate).
+class PixelProjector {
+ public:
+  explicit PixelProjector(const Camera& camera);
+  /// Row-major pixel index of the pixel containing x, or -1 if x is behind the eye or outside.
+  std::ptrdiff_t pixel(const Vec3f& x) const {
+    const Vec3d d = Vec3d(x) - eye_;
+    const double depth = dot(d, forward_);
+    if (!(depth > 0.0)) return -1;
+    const double x_ss = dot(d, right_) / depth + half_w_, y_ss = dot(d, down_) / depth + half_h_;
+    if (!(x_ss >= 0.0 && x_ss < width_ && y_ss >= 0.0 && y_ss < height_)) return -1;
+    return std::ptrdiff_t(y_ss) * std::ptrdiff_t(width_) + std::ptrdiff_t(x_ss);
+  }
+
+ private:
+  Vec3d eye_, forward_, right_, down_;
+  double half_w_ = 0, half_h_ = 0;
+  int width_ = 0, height_ = 0;
+};
+
 /// Pixel (Alg. 3): `x` projects inside `image` onto a pixel holding triangle `id`.
-bool pixel_captured(const DepthImage& image, const Camera& camera, const Vec3f& x, mesh::TriangleId id);
+bool pixel_captured(const DepthImage& image, const PixelProjector& projector, const Vec3f& x, mesh::TriangleId id);
+inline bool pixel_captured(const DepthImage& image, const Camera& camera, const Vec3f& x, mesh::TriangleId id) {
+  return pixel_captured(image, PixelProjector(camera), x, id);
+}
 
 /// Visibility (Alg. 2, plus the frustum [choice] of ALGORITHMS.md §10): `x` on triangle `id` lies in
 /// the camera's image, its face looks at the eye, and the segment eye -> x is unoccluded by front faces.
