@@ -48,7 +48,7 @@ struct Sample {
   double z = 0;  ///< view depth
 };
 
-// Reads samples of one image; `valid` is false where the pixel has none.
+// Reads the samples of one image; has() is false where the pixel has none.
 class SampleReader {
  public:
   explicit SampleReader(const DepthImage& image) : image_(image), camera_(image.camera) {}
