@@ -1,6 +1,8 @@
 // raysift mesh: iso-surfaces of a volume as one triangle mesh. Flow: parse -> load volume and TF -> choose
 // iso-values (histogram peaks + TF opacity maxima, or --iso) -> marching cubes (one surface per value) ->
 // Taubin -> decimate -> Taubin per surface -> write all surfaces into one mesh file -> stats.
+#include <tbb/parallel_for.h>
+
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -161,18 +163,26 @@ void run(const MeshCliOptions& o, const CommonOptions& common, CLI::App& sub) {
   mesh::TriMesh combined;
   mesh::StageReport smooth_before, decimate, smooth_after;
   Json surface_stats = Json::array();
+  // Surfaces are prepared concurrently (OpenMesh's decimater is serial per mesh); each result lands in its
+  // own slot and everything below walks them in iso order, so the output does not depend on scheduling.
+  std::vector<mesh::MeshPrepResult> prepared(surfaces.size());
+  tbb::parallel_for(std::size_t(0), surfaces.size(), [&](std::size_t i) {
+    if (surfaces[i].empty()) return;
+    mesh::MeshPrepOptions surface_prep = prep;
+    if (o.faces > 0)  // --faces is a total; each surface gets its share of the marching-cubes triangles
+      surface_prep.decimation.target_faces = std::min<std::size_t>(
+          surfaces[i].triangle_count(),
+          std::max<std::size_t>(4, std::size_t(std::llround(double(o.faces) * double(surfaces[i].triangle_count()) /
+                                                             double(mc_triangles)))));
+    prepared[i] = mesh::prepare_mesh(surfaces[i], surface_prep);
+  });
   for (std::size_t i = 0; i < surfaces.size(); ++i) {
     if (surfaces[i].empty()) {
       if (!common.quiet) std::cerr << "raysift: warning: iso-value " << iso_values[i] << " gives an empty surface\n";
       surface_stats.push_back({{"triangles", 0}, {"vertices", 0}, {"watertight", false}, {"euler_characteristic", 0}, {"area", 0.0}});
       continue;
     }
-    if (o.faces > 0)  // --faces is a total; each surface gets its share of the marching-cubes triangles
-      prep.decimation.target_faces = std::min<std::size_t>(
-          surfaces[i].triangle_count(),
-          std::max<std::size_t>(4, std::size_t(std::llround(double(o.faces) * double(surfaces[i].triangle_count()) /
-                                                             double(mc_triangles)))));
-    const mesh::MeshPrepResult r = mesh::prepare_mesh(surfaces[i], prep);
+    const mesh::MeshPrepResult& r = prepared[i];
     smooth_before.ms += r.smooth_before.ms;
     smooth_before.triangles += r.smooth_before.triangles;
     decimate.ms += r.decimate.ms;
