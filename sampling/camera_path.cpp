@@ -387,9 +387,7 @@ std::vector<PathFrame> render_camera_path(const volume::Volume& volume, const vo
     if (options.compare_full) frame.ssim_vs_full = mean_ssim(volume::render_full(caster).image, image);
     sink(frame, image);
     frames.push_back(frame);
-    if (!frame.refined) previous = PreviousFrame{spec, ImageRGBA(), ImageF()};
-    previous->image = std::move(image);
-    previous->depth = cache->depth;
+    previous = PreviousFrame{spec, std::move(image), cache->depth};
   }
   return frames;
 }
