@@ -38,11 +38,17 @@ CliRun raysift(const std::string& dir, const std::string& args, const std::strin
 
 const std::string kDatasets = std::string(RAYSIFT_SOURCE_DIR) + "/datasets";
 
-/// A 12-voxel ball (make-volume) and a step TF at its surface value 0.5 with opacity 0.3 per voxel.
+/// A fresh directory holding ball.vdb (a 12-voxel ball from make-volume, made once per run and copied)
+/// and tf.json (a step TF at its surface value 0.5, opacity 0.3 per voxel).
 std::string make_ball_dir(const std::string& tag) {
+  static const std::string source = [] {
+    const std::string dir = test::make_temp_dir("render_ball_source");
+    const CliRun make = raysift(dir, "make-volume ball --dims 32,32,32 --radius 12 --quiet -o ball.vdb");
+    EXPECT_EQ(make.code, 0) << make.err;
+    return dir;
+  }();
   const std::string dir = test::make_temp_dir(tag);
-  const CliRun make = raysift(dir, "make-volume ball --dims 32,32,32 --radius 12 --quiet -o ball.vdb");
-  EXPECT_EQ(make.code, 0) << make.err;
+  fs::copy_file(source + "/ball.vdb", dir + "/ball.vdb");
   write_json_file(dir + "/tf.json", Json::parse(R"({"points": [[0,1,0.5,0,0],[0.5,1,0.5,0,0],[0.51,1,0.5,0,0.3],[1,1,0.5,0,0.3]]})"));
   return dir;
 }
