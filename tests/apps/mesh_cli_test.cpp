@@ -72,6 +72,16 @@ TEST_F(MeshCli, TransferFunctionChoosesTheIsoValue) {
   EXPECT_NEAR(s.at("iso_values").back().get<double>(), 1.0, 0.01);
 }
 
+TEST_F(MeshCli, SceneProvidesVolumeAndTransferFunction) {
+  std::ofstream(dir_ + "/scene.json")
+      << R"({"volume": "ball.vdb", "transfer_function": {"points": [[0,0,0,0,0],[0.3,1,1,1,0],[0.6,1,1,1,0.8],[1,1,1,1,0.8]]}})";
+  const CliResult r = run_raysift(dir_, "mesh --scene scene.json --smooth 0 --decimate 1 -o scene.ply --stats scene_stats.json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Json s = read_json_file(dir_ + "/scene_stats.json");
+  EXPECT_NEAR(s.at("iso_values").back().get<double>(), 1.0, 0.01);  // same TF as tf.json, same choice
+  EXPECT_TRUE(s.at("surfaces").back().at("watertight").get<bool>());
+}
+
 TEST_F(MeshCli, BadInputFailsWithoutOutput) {
   struct Case {
     std::string args;
