@@ -70,17 +70,22 @@ std::pair<std::size_t, std::size_t> find_conversion(const std::string& pattern, 
   return found;
 }
 
-/// Bilinear value of `map` (covering the whole frame at its own resolution) at the centre of frame
-/// pixel (x, y); clamped at the border.
-float sample_map(const ImageF& map, int x, int y, int frame_w, int frame_h) {
-  const double fx = std::clamp((x + 0.5) * map.width / frame_w - 0.5, 0.0, double(map.width - 1));
-  const double fy = std::clamp((y + 0.5) * map.height / frame_h - 0.5, 0.0, double(map.height - 1));
-  const int x0 = int(fx), y0 = int(fy);
-  const int x1 = std::min(x0 + 1, map.width - 1), y1 = std::min(y0 + 1, map.height - 1);
-  const float tx = float(fx - x0), ty = float(fy - y0);
-  const float top = map(x0, y0) + tx * (map(x1, y0) - map(x0, y0));
-  const float bottom = map(x0, y1) + tx * (map(x1, y1) - map(x0, y1));
-  return top + ty * (bottom - top);
+/// Bilinear taps along one axis for reading a map of `n_map` pixels at the centres of `n_frame` frame
+/// pixels (both cover the same extent); clamped at the border.
+struct Taps {
+  std::vector<int> lo, hi;
+  std::vector<float> t;
+};
+
+Taps bilinear_taps(int n_frame, int n_map) {
+  Taps taps;
+  for (int i = 0; i < n_frame; ++i) {
+    const double f = std::clamp((i + 0.5) * n_map / n_frame - 0.5, 0.0, double(n_map - 1));
+    taps.lo.push_back(int(f));
+    taps.hi.push_back(std::min(int(f) + 1, n_map - 1));
+    taps.t.push_back(float(f - int(f)));
+  }
+  return taps;
 }
 
 /// Every ray traced since the camera last moved: colour, depth and whether it is known. A still camera
@@ -282,10 +287,19 @@ ImageF path_frame_importance(const volume::RayCaster& caster, const FeatureGeome
       features::warp_map(map, features::downsample_depth(previous->depth, map.width, map.height),
                          Camera(previous->camera), caster.camera(), warp);
   const int w = importance.width, h = importance.height;
+  const Taps tx = bilinear_taps(w, warped.map.width), ty = bilinear_taps(h, warped.map.height);
+  const ImageF& m = warped.map;
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
-    for (int y = rows.begin(); y < rows.end(); ++y)
-      for (int x = 0; x < w; ++x)
-        if (importance(x, y) >= 0.f) importance(x, y) = std::max(importance(x, y), sample_map(warped.map, x, y, w, h));
+    for (int y = rows.begin(); y < rows.end(); ++y) {
+      const std::size_t j = std::size_t(y);
+      for (int x = 0; x < w; ++x) {
+        if (importance(x, y) < 0.f) continue;  // background stays background
+        const std::size_t i = std::size_t(x);
+        const float top = m(tx.lo[i], ty.lo[j]) + tx.t[i] * (m(tx.hi[i], ty.lo[j]) - m(tx.lo[i], ty.lo[j]));
+        const float bottom = m(tx.lo[i], ty.hi[j]) + tx.t[i] * (m(tx.hi[i], ty.hi[j]) - m(tx.lo[i], ty.hi[j]));
+        importance(x, y) = std::max(importance(x, y), top + ty.t[j] * (bottom - top));
+      }
+    }
   });
   if (saliency_ms != nullptr) *saliency_ms = timer.elapsed_ms();
   return importance;
