@@ -32,6 +32,12 @@ std::uint64_t hash64(std::uint64_t v) {
   return v ^ (v >> 31);
 }
 
+/// Ceiling for |x| < 2^62 without a libm call (std::ceil is one without SSE4.1).
+long ceil_long(double x) {
+  const long i = long(x);
+  return i + (x > double(i) ? 1 : 0);
+}
+
 /// Slab test of the ray o + t·d against [lo, hi]; false if it misses.
 bool clip_to_box(const Vec3d& o, const Vec3d& inv_d, const Vec3d& lo, const Vec3d& hi, double& t0, double& t1) {
   t0 = -kInf;
@@ -192,6 +198,7 @@ RaySample RayCaster::Impl::trace(int x, int y) const {
   if (!(t_in < t_out)) return out;
 
   const double dt = options.step_voxels;
+  const double inv_dt = 1.0 / dt;
   const double xi = options.jitter
                         ? double(hash64(hash64(std::uint64_t(y) * std::uint64_t(camera.width()) + std::uint64_t(x)) ^
                                         options.seed) >> 11) * 0x1.0p-53
@@ -203,7 +210,7 @@ RaySample RayCaster::Impl::trace(int x, int y) const {
     double tv_in, tv_out;
     if (!clip_to_box(o, inv_d, visible_lo, visible_hi, tv_in, tv_out) || tv_out < t_in) return out;
     // One step of slack on both sides: the per-sample block test below is the exact criterion.
-    k = std::max(0L, long(std::ceil((tv_in - t_in) / dt - xi)) - 1);
+    k = std::max(0L, ceil_long((tv_in - t_in) * inv_dt - xi) - 1);
     t_end = std::min(t_out, tv_out + dt);
   }
 
@@ -223,7 +230,7 @@ RaySample RayCaster::Impl::trace(int x, int y) const {
       // Jump to one step before the block exit; the next position is tested again.
       const double t_exit =
           block_exit(o, inv_d, cell.ix >> kBlockLog2, cell.iy >> kBlockLog2, cell.iz >> kBlockLog2);
-      const long k_next = long(std::ceil((t_exit - t_in) / dt - xi)) - 1;
+      const long k_next = ceil_long((t_exit - t_in) * inv_dt - xi) - 1;
       k = std::max(k + 1, k_next);
       continue;
     }
