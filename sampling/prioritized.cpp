@@ -209,8 +209,10 @@ SampledFrame ProgressiveSampler::next_frame(const TraceBatch& trace) {
     next_ = queue_.level0_count;
   }
   if (options_.budget_ms > 0) {
-    const double reserve = options_.reconstruct_reserve_ms >= 0
-                               ? options_.reconstruct_reserve_ms
+    // The previous frame's reconstruction time (with 25% margin) is the best estimate for this one.
+    const double reserve = options_.reconstruct_reserve_ms >= 0 ? options_.reconstruct_reserve_ms
+                           : last_reconstruct_ms_ >= 0
+                               ? 1.25 * last_reconstruct_ms_
                                : estimate_reconstruct_ms(samples_.width, samples_.height, options_.base_spacing);
     const double deadline = options_.budget_ms - reserve;
     frame.budget_too_small = begin == 0 && clock.elapsed_ms() > deadline;
@@ -232,6 +234,7 @@ SampledFrame ProgressiveSampler::next_frame(const TraceBatch& trace) {
   frame.image = samples_;
   if (!converged()) reconstruct_fractal(frame.image, known_, pattern_);
   frame.reconstruct_ms = stage.elapsed_ms();
+  last_reconstruct_ms_ = frame.reconstruct_ms;
   return frame;
 }
 

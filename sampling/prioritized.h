@@ -6,7 +6,7 @@
 /// same priority queue frame after frame and converges to the full render.
 #include <cstdint>
 #include <limits>
-#include <memory>
+#include <string>
 
 #include "core/image.h"
 #include "sampling/fractal_pattern.h"
@@ -91,6 +91,7 @@ class ProgressiveSampler {
   ImageMask known_;
   std::size_t next_ = 0;
   double priorities_ms_ = 0;
+  double last_reconstruct_ms_ = -1;  ///< < 0 until a frame was reconstructed
 };
 
 }  // namespace raysift::sampling
