@@ -32,10 +32,10 @@ TradeResult run_trade(const volume::RayCaster& caster, const FeatureGeometry* ge
     volume::RenderResult full = volume::render_full(caster);
     const double ms = timer.elapsed_ms();
     full_row.trace_ms = full_row.total_ms = std::min(full_row.total_ms, ms);
-    full_row.rays_traced = full.rays_traced;
     result.full_image = std::move(full.image);
   }
-  // Object pixels: the ones the full render traces (not background by the caster's exact test).
+  // Object pixels: the ones the full render traces (not background by the caster's exact test). This is a
+  // superset of alpha > 0 (rays through transparent parts of the visible blocks' box count as object).
   const ImageMask object = mask_from_importance(frame_importance(caster, nullptr, FeatureOptions{}));
   std::size_t object_rays = 0;
   for (std::uint8_t m : object.pixels) object_rays += m;
