@@ -4,7 +4,8 @@
 //
 // Part 2 (RP paper §5, issue 9): an orbit of N frames (default 60) around the same view with
 // --target-fps set to 3x the measured full-render rate, contours + silhouettes as line features, with and
-// without saliency: the share of frames within +10 % of the target time and the mean SSIM vs full renders.
+// without saliency (run A B B A): the share of frames within +10 % of the target time and the mean SSIM vs
+// full renders.
 //
 // Usage: saliency_bench [--frames N] [--per-frame] [VOLUME.vdb [TF.json [CAMERA.json]]]
 //   (default: datasets/engine_ct{.vdb,_tf.json,_camera.json}; the camera is rendered at 1440x900; N = 0 skips part 2)
@@ -67,7 +68,14 @@ void run_orbit(const volume::Volume& vol, const volume::TransferFunction& tf, co
   for (int i = 0; i < frames; ++i) cameras.push_back(orbit_step(start, 360.0 * i / frames));
   std::printf("%-26s %10s %10s %10s %12s %10s\n", "features", "within10%", "mean ms", "mean rays", "mean SSIM",
               "sal. ms");
-  for (const bool use_saliency : {false, true}) {
+  // Order A B B A: machine load drifting during the run then affects both variants alike; the last two
+  // rows average each variant's two runs.
+  struct Totals {
+    double within = 0, ms = 0, rays = 0, ssim = 0, saliency = 0;
+    int runs = 0;
+  };
+  Totals totals[2];
+  for (const bool use_saliency : {false, true, true, false}) {
     sampling::PathRenderOptions opt;
     opt.sampling.mode = sampling::SamplingMode::Prioritized;
     opt.features.lines.classes = sampling::parse_feature_list("contours,silhouettes");
@@ -89,10 +97,23 @@ void run_orbit(const volume::Volume& vol, const volume::TransferFunction& tf, co
       saliency += f.saliency_ms;
     }
     const double n = double(path.size());
+    Totals& t = totals[use_saliency ? 1 : 0];
+    t.within += stats.at("within_10pct_of_target").get<double>();
+    t.ms += ms / n;
+    t.rays += rays / n;
+    t.ssim += stats.at("mean_ssim_vs_full").get<double>();
+    t.saliency += saliency / n;
+    ++t.runs;
     std::printf("%-26s %9.0f%% %10.1f %9.1f%% %12.4f %10.1f\n",
                 use_saliency ? "contours+sil + saliency" : "contours+silhouettes",
                 100.0 * stats.at("within_10pct_of_target").get<double>(), ms / n, 100.0 * rays / n,
                 stats.at("mean_ssim_vs_full").get<double>(), saliency / n);
+  }
+  for (int v = 0; v < 2; ++v) {
+    const Totals& t = totals[v];
+    std::printf("%-26s %9.0f%% %10.1f %9.1f%% %12.4f %10.1f   (mean of %d runs)\n",
+                v ? "MEAN contours+sil+saliency" : "MEAN contours+silhouettes", 100.0 * t.within / t.runs,
+                t.ms / t.runs, 100.0 * t.rays / t.runs, t.ssim / t.runs, t.saliency / t.runs, t.runs);
   }
 }
 
