@@ -179,8 +179,7 @@ void scaling_table(const Config& cfg) {
   std::printf("\nGrass scaling, end to end (ms, incl. BVH build), %dx%d light samples, %dx%d output\n", cfg.samples,
               cfg.samples, cfg.output, cfg.output);
   std::printf("%-10s %10s %12s %12s %16s\n", "triangles", "raytrace", "shadowmap", "nrr", "nrr fit+512");
-  const std::vector<std::size_t> sizes = cfg.quick ? std::vector<std::size_t>{50000, 200000, 500000}
-                                                   : std::vector<std::size_t>{50000, 200000, 500000, 1000000, 2000000};
+  const std::vector<std::size_t> sizes = {50000, 200000, 500000, 1000000, 2000000};
   for (std::size_t n : sizes) {
     const BenchScene s = generated("grass", n);
     double t[4];
