@@ -139,8 +139,8 @@ RegisterCommand reg(
         } catch (const InvalidInput&) {
           bad_flag("--redundancy", "pixel or visibility", "'" + o.redundancy + "'");
         }
-        if (!o.out_dir.empty() && !std::filesystem::is_directory(o.out_dir))
-          throw IoError(file_message(o.out_dir, "output folder does not exist; create it first"));
+        if (!o.out_dir.empty() && std::filesystem::exists(o.out_dir) && !std::filesystem::is_directory(o.out_dir))
+          throw IoError(file_message(o.out_dir, "exists and is not a folder; -o takes an output folder"));
         sampling.peel_layers = o.layers;
         const nrr::ViewSet views = views_from_options(o);
         if (!o.skip_metrics && views.views.size() > 4 && views.intermediate.empty())
@@ -202,6 +202,7 @@ RegisterCommand reg(
 
         if (!o.out_dir.empty()) {
           const std::filesystem::path dir(o.out_dir);
+          std::filesystem::create_directories(dir);  // only now: a failed run leaves no folder behind
           for (std::size_t i = 0; i < images.size(); ++i) {
             const std::string stem = (dir / ("image_" + std::to_string(i))).string();
             nrr::write_depth_image(images[i], stem + ".exr", stem + ".png");

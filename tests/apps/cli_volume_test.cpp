@@ -18,38 +18,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int code = -1;
-  std::string out, err;
-};
+using test::CliRun;
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+CliRun raysift(const std::string& dir, const std::string& args) { return test::run_cli(RAYSIFT_EXE, dir, args); }
 
-/// Runs raysift with `args` in `dir` and captures its exit code, stdout and stderr (in files named by `tag`).
-CliRun raysift(const std::string& dir, const std::string& args, const std::string& tag = "") {
-  const std::string out = "stdout" + tag + ".txt", err = "stderr" + tag + ".txt";
-  const std::string cmd = "cd '" + dir + "' && '" + RAYSIFT_EXE + "' " + args + " >" + out + " 2>" + err;
-  const int status = std::system(cmd.c_str());
-  CliRun r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(dir + "/" + out);
-  r.err = slurp(dir + "/" + err);
-  return r;
-}
-
-/// Runs independent invocations concurrently: process start-up (hundreds of shared libraries) dominates.
 std::vector<CliRun> raysift_all(const std::string& dir, const std::vector<std::string>& args) {
-  std::vector<std::future<CliRun>> jobs;
-  for (std::size_t i = 0; i < args.size(); ++i)
-    jobs.push_back(std::async(std::launch::async, [&, i] { return raysift(dir, args[i], std::to_string(i)); }));
-  std::vector<CliRun> runs;
-  for (auto& j : jobs) runs.push_back(j.get());
-  return runs;
+  return test::run_cli_all(RAYSIFT_EXE, dir, args);
 }
 
 void write_file(const std::string& path, const std::string& bytes) {
@@ -179,7 +153,7 @@ TEST(CliVolume, BadInputExitsOneWithOneLineErrorAndNoOutputFile) {
   write_file(dir + "/v.raw", std::string(63, '\x01'));
   fs::create_directory(dir + "/folder.vdb");
   ASSERT_EQ(raysift(dir, "make-volume torus --dims 32,32,32 --major-radius 9 --minor-radius 3 -o t.vdb").code, 0);
-  const std::string full = slurp(dir + "/t.vdb");
+  const std::string full = test::read_text(dir + "/t.vdb");
   write_file(dir + "/cut.vdb", full.substr(0, full.size() / 2));
   struct Case {
     std::string args, expect;

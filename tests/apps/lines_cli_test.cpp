@@ -18,20 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int code = -1;
-  std::string err;
-};
-
-CliRun run_raysift(const std::string& dir, const std::string& args, const std::string& tag) {
-  const std::string err = dir + "/stderr" + tag + ".txt";
-  const std::string cmd = "cd '" + dir + "' && '" + RAYSIFT_EXE + "' " + args + " >/dev/null 2>'" + err + "'";
-  const int status = std::system(cmd.c_str());
-  std::ifstream in(err);
-  std::stringstream s;
-  s << in.rdbuf();
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, s.str()};
-}
+using test::CliRun;
 
 /// Latitude-longitude sphere of radius 1 as OFF text (CCW seen from outside), with an optional NaN vertex.
 std::string sphere_off(bool with_nan) {
@@ -75,11 +62,7 @@ TEST(LinesCli, WritesPictureSvgImportanceAndStats) {
       "lines nan.off -o nan.png",
       "lines sphere.off -o bad_scale.png --importance bad_scale.exr --importance-scale 0",
       "lines sphere.off -o inside.png --camera inside.json --importance inside.exr"};
-  std::vector<std::future<CliRun>> jobs;
-  for (std::size_t i = 0; i < args.size(); ++i)
-    jobs.push_back(std::async(std::launch::async, [&, i] { return run_raysift(dir, args[i], std::to_string(i)); }));
-  std::vector<CliRun> r;
-  for (auto& j : jobs) r.push_back(j.get());
+  const std::vector<CliRun> r = test::run_cli_all(RAYSIFT_EXE, dir, args);
 
   ASSERT_EQ(r[0].code, 0) << r[0].err;
   EXPECT_TRUE(fs::exists(dir + "/ok.png") && fs::exists(dir + "/ok.svg") && fs::exists(dir + "/ok.exr"));

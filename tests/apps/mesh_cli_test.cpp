@@ -14,19 +14,9 @@
 namespace raysift {
 namespace {
 
-struct CliResult {
-  int code = -1;
-  std::string err;
-};
+using test::CliRun;
 
-CliResult run_raysift(const std::string& dir, const std::string& args) {
-  const std::string cmd = "cd '" + dir + "' && '" + RAYSIFT_EXE + "' " + args + " >stdout.txt 2>stderr.txt";
-  const int status = std::system(cmd.c_str());
-  std::ifstream in(dir + "/stderr.txt");
-  std::stringstream s;
-  s << in.rdbuf();
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, s.str()};
-}
+CliRun run_raysift(const std::string& dir, const std::string& args) { return test::run_cli(RAYSIFT_EXE, dir, args); }
 
 class MeshCli : public ::testing::Test {
  protected:
@@ -42,7 +32,7 @@ class MeshCli : public ::testing::Test {
 std::string MeshCli::dir_;
 
 TEST_F(MeshCli, WritesMeshAndStats) {
-  const CliResult r = run_raysift(dir_, "mesh ball.vdb --iso 0.5 --smooth 5 --decimate 0.5 -o ball.ply --stats stats.json");
+  const CliRun r = run_raysift(dir_, "mesh ball.vdb --iso 0.5 --smooth 5 --decimate 0.5 -o ball.ply --stats stats.json");
   ASSERT_EQ(r.code, 0) << r.err;
   ASSERT_TRUE(std::filesystem::exists(dir_ + "/ball.ply"));
   const Json s = read_json_file(dir_ + "/stats.json");
@@ -64,7 +54,7 @@ TEST_F(MeshCli, WritesMeshAndStats) {
 }
 
 TEST_F(MeshCli, TransferFunctionChoosesTheIsoValue) {
-  const CliResult r = run_raysift(dir_, "mesh ball.vdb --tf tf.json --smooth 0 --decimate 1 -o tf.ply --stats tf_stats.json");
+  const CliRun r = run_raysift(dir_, "mesh ball.vdb --tf tf.json --smooth 0 --decimate 1 -o tf.ply --stats tf_stats.json");
   ASSERT_EQ(r.code, 0) << r.err;
   const Json s = read_json_file(dir_ + "/tf_stats.json");
   // The ball's histogram peaks at its density 1 (opacity 0.8 there).
@@ -75,7 +65,7 @@ TEST_F(MeshCli, TransferFunctionChoosesTheIsoValue) {
 TEST_F(MeshCli, SceneProvidesVolumeAndTransferFunction) {
   std::ofstream(dir_ + "/scene.json")
       << R"({"volume": "ball.vdb", "transfer_function": {"points": [[0,0,0,0,0],[0.3,1,1,1,0],[0.6,1,1,1,0.8],[1,1,1,1,0.8]]}})";
-  const CliResult r = run_raysift(dir_, "mesh --scene scene.json --smooth 0 --decimate 1 -o scene.ply --stats scene_stats.json");
+  const CliRun r = run_raysift(dir_, "mesh --scene scene.json --smooth 0 --decimate 1 -o scene.ply --stats scene_stats.json");
   ASSERT_EQ(r.code, 0) << r.err;
   const Json s = read_json_file(dir_ + "/scene_stats.json");
   EXPECT_NEAR(s.at("iso_values").back().get<double>(), 1.0, 0.01);  // same TF as tf.json, same choice
@@ -97,14 +87,14 @@ TEST_F(MeshCli, BadInputFailsWithoutOutput) {
       {"mesh ../ball.vdb --iso 0.5 --decimate 0.5 --faces 100 -o f.ply", 2, "exclusive"},
   };
   // Independent runs in parallel (process start-up dominates), each in its own folder for its captured output.
-  std::vector<std::future<CliResult>> runs;
+  std::vector<std::future<CliRun>> runs;
   for (std::size_t i = 0; i < std::size(cases); ++i) {
     const std::string sub = dir_ + "/case" + std::to_string(i);
     std::filesystem::create_directories(sub);
     runs.push_back(std::async(std::launch::async, [sub, args = cases[i].args] { return run_raysift(sub, args); }));
   }
   for (std::size_t i = 0; i < std::size(cases); ++i) {
-    const CliResult r = runs[i].get();
+    const CliRun r = runs[i].get();
     const Case& c = cases[i];
     EXPECT_EQ(r.code, c.code) << c.args << "\n" << r.err;
     EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << "\n" << r.err;
