@@ -15,13 +15,12 @@
 namespace raysift::sampling {
 
 /// The six coefficients of the second-order mapping, in the order a00, a10, a01, a11, a20, a02
-/// (first index: power of p_imp, second: power of p_patt). [choice] Default a00 = a01 = 0.5, a10 = a11 = 0.1,
-/// a20 = a02 = 0: with the paper's 0.5 for all four, any line pixel outranks every non-line pixel beyond
-/// level 0, which starves flat interiors at low ray counts; a10 = a11 = 0.1 gives lines about 1.4-2.8
-/// extra pattern levels instead (measured trade in docs/prioritized.md). "0.5,0.5,0.5,0.5,0,0" restores
-/// the paper's setting.
+/// (first index: power of p_imp, second: power of p_patt). Default: the contract, a20 = a02 = 0 and 0.5
+/// for the other four. With it any line pixel outranks every non-line pixel beyond level 0, which starves flat
+/// interiors at low ray counts; "0.5,0.1,0.5,0.1,0,0" (a10 = a11 = 0.1) gives lines about 1.4-2.8 extra pattern
+/// levels instead and measured better (docs/prioritized.md), so it is the recommended `--alpha`.
 struct PriorityMapping {
-  std::array<float, 6> alpha{0.5f, 0.1f, 0.5f, 0.1f, 0.0f, 0.0f};
+  std::array<float, 6> alpha{0.5f, 0.5f, 0.5f, 0.5f, 0.0f, 0.0f};
 };
 
 /// \throw InvalidInput unless `text` is six comma-separated finite numbers.

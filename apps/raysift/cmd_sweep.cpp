@@ -99,7 +99,7 @@ RegisterCommand reg(
       sub.add_option("--ray-fractions", opt->fractions, "comma-separated fractions in (0, 1]")->capture_default_str();
       sub.add_option("--plot", opt->plot, "also draw error vs fraction and vs time per mode (PNG)");
       sub.add_option("--features", opt->features, "line classes of the prioritized rows")->capture_default_str();
-      sub.add_option("--alpha", opt->alpha, "priority mapping a00,a10,a01,a11,a20,a02 (default 0.5,0.1,0.5,0.1,0,0)");
+      sub.add_option("--alpha", opt->alpha, "priority mapping a00,a10,a01,a11,a20,a02 (default 0.5,0.5,0.5,0.5,0,0; recommended 0.5,0.1,0.5,0.1,0,0)");
       sub.add_option("--feature-mesh", opt->feature_mesh, "prepared feature mesh instead of the iso-surfaces");
       sub.add_option("--shading", opt->shading, "none|phong")->capture_default_str();
       sub.add_option("--width", opt->width, "image width (default: the scene camera's)");
