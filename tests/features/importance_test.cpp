@@ -129,7 +129,9 @@ TEST_F(SphereImportance, BackgroundIsNegativeObjectZeroSilhouetteOne) {
     for (int x = 0; x < 256; ++x) {
       const Ray r = cam.ray(x + 0.5, y + 0.5);
       const double bq = dot(r.origin, r.direction), cq = dot(r.origin, r.origin) - 1.0;
-      if (bq * bq - cq >= 0) ASSERT_GE(sample_importance(b, x, y), 0.0f) << x << "," << y;
+      if (bq * bq - cq >= 0) {
+        ASSERT_GE(sample_importance(b, x, y), 0.0f) << x << "," << y;
+      }
     }
   EXPECT_TRUE(all_finite(b.values));
 }

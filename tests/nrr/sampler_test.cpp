@@ -138,7 +138,9 @@ TEST(Sampler, ConvexMeshLaterImagesHoldOnlyWhatEarlierEyesCannotSee) {
         const Vec3d n = scene.face_normal(conv[i].triangle_id[p]);
         bool is_seen = false;
         for (std::size_t j = 0; j < i; ++j) is_seen = is_seen || dot(n, views[j].eye - x) > 0.0;
-        if (nrr[i].has_sample(p)) ASSERT_EQ(nrr[i].triangle_id[p], conv[i].triangle_id[p]);  // one layer only
+        if (nrr[i].has_sample(p)) {
+          ASSERT_EQ(nrr[i].triangle_id[p], conv[i].triangle_id[p]);  // one layer only
+        }
         if (!is_seen) {
           ASSERT_TRUE(nrr[i].has_sample(p)) << "hidden part dropped, image " << i << " pixel " << p;
           continue;
