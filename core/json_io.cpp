@@ -21,6 +21,8 @@ Json read_json_file(const std::string& path) {
     const auto pos = what.find("parse error");
     if (pos != std::string::npos) what = what.substr(pos);
     throw InvalidInput(path + ":" + std::to_string(line) + ":" + std::to_string(col) + ": malformed JSON: " + what);
+  } catch (const Json::exception& e) {  // e.g. a number too large for a double ("1e999")
+    throw InvalidInput(file_message(path, std::string("unreadable JSON value: ") + e.what()));
   }
 }
 

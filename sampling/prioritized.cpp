@@ -99,6 +99,7 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
   validate(options);
   require_finite_importance(importance);
   const Timer clock;
+  const ElapsedMs now = options.clock_ms ? options.clock_ms : ElapsedMs([&clock] { return clock.elapsed_ms(); });
   const int w = importance.width, h = importance.height;
   SampledFrame frame;
   frame.image = ImageRGBA(w, h);
@@ -152,10 +153,10 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
     const Span<const std::uint32_t> all(queue.pixels.data(), queue.pixels.size());
     trace_all(Span<const std::uint32_t>(all.data(), queue.level0_count), trace, frame.image);
     const double deadline = options.budget_ms - elapsed_before_ms - reserve;
-    frame.budget_too_small = clock.elapsed_ms() > deadline;
+    frame.budget_too_small = now() > deadline;
     const std::size_t more = trace_until(Span<const std::uint32_t>(all.data() + queue.level0_count,
                                                                    all.size() - queue.level0_count),
-                                         trace, frame.image, clock, deadline);
+                                         trace, frame.image, now, deadline);
     frame.rays_traced = queue.level0_count + more;
     frame.trace_ms = stage.elapsed_ms();
     mark(Span<const std::uint32_t>(queue.pixels.data(), frame.rays_traced), frame.traced);
@@ -195,6 +196,7 @@ ProgressiveSampler::ProgressiveSampler(const ImageF& importance, const SamplingO
 
 SampledFrame ProgressiveSampler::next_frame(const TraceBatch& trace) {
   const Timer clock;
+  const ElapsedMs now = options_.clock_ms ? options_.clock_ms : ElapsedMs([&clock] { return clock.elapsed_ms(); });
   SampledFrame frame;
   frame.full_rays = queue_.object_pixels;
   frame.level0_rays = queue_.level0_count;
@@ -215,8 +217,8 @@ SampledFrame ProgressiveSampler::next_frame(const TraceBatch& trace) {
                                ? 1.25 * last_reconstruct_ms_
                                : estimate_reconstruct_ms(samples_.width, samples_.height, options_.base_spacing);
     const double deadline = options_.budget_ms - reserve;
-    frame.budget_too_small = begin == 0 && clock.elapsed_ms() > deadline;
-    next_ += trace_until(Span<const std::uint32_t>(all.data() + next_, all.size() - next_), trace, samples_, clock,
+    frame.budget_too_small = begin == 0 && now() > deadline;
+    next_ += trace_until(Span<const std::uint32_t>(all.data() + next_, all.size() - next_), trace, samples_, now,
                          deadline);
   } else {
     const auto step = std::size_t(std::llround(options_.ray_fraction * double(queue_.object_pixels)));

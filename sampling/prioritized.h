@@ -38,6 +38,8 @@ struct SamplingOptions {
   int base_spacing = 8;   ///< fractal level-0 spacing, px (power of two)
   int buckets = 256;      ///< priority buckets of the budget/progressive queue
   std::uint64_t seed = 1;
+  /// Budget mode time source (ms since the frame began); empty = the wall clock.
+  ElapsedMs clock_ms;
 };
 
 /// \throw InvalidInput for a fraction outside (0,1], a negative or non-finite budget, a bad spacing or

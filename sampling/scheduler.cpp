@@ -29,8 +29,8 @@ void trace_all(Span<const std::uint32_t> pixels, const TraceBatch& trace, ImageR
   });
 }
 
-std::size_t trace_until(Span<const std::uint32_t> queue, const TraceBatch& trace, ImageRGBA& image, const Timer& clock,
-                        double deadline_ms) {
+std::size_t trace_until(Span<const std::uint32_t> queue, const TraceBatch& trace, ImageRGBA& image,
+                        const ElapsedMs& elapsed_ms, double deadline_ms) {
   const std::size_t groups = (queue.size() + kRayGroup - 1) / kRayGroup;
   std::atomic<std::size_t> next{0};
   std::atomic<std::size_t> claimed{0};
@@ -38,7 +38,7 @@ std::size_t trace_until(Span<const std::uint32_t> queue, const TraceBatch& trace
   // One long-running task per worker; each checks the clock before claiming the next group, so at most
   // one group per worker runs past the deadline.
   tbb::parallel_for(tbb::blocked_range<int>(0, workers, 1), [&](const tbb::blocked_range<int>&) {
-    while (clock.elapsed_ms() < deadline_ms) {
+    while (elapsed_ms() < deadline_ms) {
       const std::size_t g = next.fetch_add(1);
       if (g >= groups) break;
       const std::size_t first = g * kRayGroup, count = std::min(kRayGroup, queue.size() - first);

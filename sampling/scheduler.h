@@ -21,10 +21,14 @@ inline constexpr std::size_t kRayGroup = 32;
 /// Traces every pixel of `pixels` in parallel groups of kRayGroup and stores the results in `image`.
 void trace_all(Span<const std::uint32_t> pixels, const TraceBatch& trace, ImageRGBA& image);
 
+/// Milliseconds since the frame began. The wall clock in production; tests inject a virtual clock that a
+/// mock tracer advances by a known cost per ray, so budget behaviour is checked independently of machine load.
+using ElapsedMs = std::function<double()>;
+
 /// \brief Traces `queue` from its start in groups of kRayGroup, in order, on all worker threads, and
-/// stops launching new groups once `clock` passes `deadline_ms`. Groups are claimed in order, so the
+/// stops launching new groups once `elapsed_ms()` reaches `deadline_ms`. Groups are claimed in order, so the
 /// traced rays are always a prefix of the queue. \return the length of that prefix.
-std::size_t trace_until(Span<const std::uint32_t> queue, const TraceBatch& trace, ImageRGBA& image, const Timer& clock,
-                        double deadline_ms);
+std::size_t trace_until(Span<const std::uint32_t> queue, const TraceBatch& trace, ImageRGBA& image,
+                        const ElapsedMs& elapsed_ms, double deadline_ms);
 
 }  // namespace raysift::sampling

@@ -26,6 +26,17 @@ TEST(Json, MalformedJsonNamesFileAndLine) {
   }
 }
 
+TEST(Json, OverflowingNumberNamesTheFile) {
+  const std::string dir = test::make_temp_dir("json");
+  write_text(dir + "/huge.json", R"({"eye": [1e999, 0, 0]})");
+  try {
+    read_json_file(dir + "/huge.json");
+    FAIL();
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("huge.json"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Json, MissingFileAndDirectoryAreIoErrors) {
   const std::string dir = test::make_temp_dir("json");
   EXPECT_THROW(read_json_file(dir + "/none.json"), IoError);

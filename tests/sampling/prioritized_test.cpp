@@ -5,7 +5,6 @@
 #include <tbb/task_arena.h>
 
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <mutex>
 #include <vector>
@@ -33,32 +32,31 @@ Rgba mock_colour(std::uint32_t pixel) {
 }
 
 // Records every traced pixel (and how often); optionally busy-waits a fixed time per ray.
+/// Records which pixels were traced. With a per-ray cost it advances a virtual clock (microseconds of
+/// work done so far, as if on one core) instead of burning time, so budget tests do not depend on load.
 struct MockTracer {
   explicit MockTracer(std::size_t pixels, double us_per_ray = 0) : count(pixels), cost_us(us_per_ray) {
     for (auto& c : count) c = 0;
   }
   std::vector<std::atomic<int>> count;
   double cost_us;
+  std::atomic<std::int64_t> virtual_us{0};
   std::mutex launch_mutex;
-  std::vector<double> launch_ms;  // clock reading at each batch start (budget tests)
-  const Timer* clock = nullptr;
+  std::vector<double> launch_ms;  // virtual clock at each batch start (budget tests)
+
+  double now_ms() const { return double(virtual_us.load()) / 1000.0; }
 
   TraceBatch batch() {
     return [this](Span<const std::uint32_t> pixels, Span<Rgba> out) {
-      if (clock) {
+      {
         std::lock_guard<std::mutex> lock(launch_mutex);
-        launch_ms.push_back(clock->elapsed_ms());
+        launch_ms.push_back(now_ms());
       }
       for (std::size_t i = 0; i < pixels.size(); ++i) {
         count[pixels[i]]++;
         out[i] = mock_colour(pixels[i]);
       }
-      if (cost_us > 0) {
-        const auto until = std::chrono::steady_clock::now() +
-                           std::chrono::duration<double, std::micro>(cost_us * double(pixels.size()));
-        while (std::chrono::steady_clock::now() < until) {
-        }
-      }
+      virtual_us += std::int64_t(std::llround(cost_us * double(pixels.size())));
     };
   }
   std::size_t traced() const {
@@ -168,20 +166,24 @@ TEST(SampledFrame, BudgetStopsLaunchingAtDeadlineInPriorityOrder) {
   SamplingOptions o = options_for(SamplingMode::Prioritized, 1.0);
   o.budget_ms = 40;
   o.reconstruct_reserve_ms = 5;
-  // 20 us per ray: the 11k object rays would take ~230 ms on one core, far beyond the budget.
+  // 20 us per ray: the 11k object rays would take ~230 ms of (virtual) work, far beyond the budget.
   MockTracer mock(imp.size(), 20.0);
-  const Timer clock;
-  mock.clock = &clock;
+  o.clock_ms = [&mock] { return mock.now_ms(); };
   const SampledFrame frame = render_sampled(imp, mock.batch(), o);
   const double deadline = o.budget_ms - o.reconstruct_reserve_ms;
   ASSERT_GT(frame.rays_traced, frame.level0_rays);
   ASSERT_LT(frame.rays_traced, frame.full_rays);
-  // Past the level-0 groups, no group may be launched after the deadline (so at most one group per
-  // worker finishes late).
+  // Past the level-0 groups, a group is launched only before the deadline: a worker checks the clock,
+  // then claims a group, while the other workers may finish one group each in between.
+  const double group_ms = 20.0 * kRayGroup / 1000.0;
+  const int workers = tbb::this_task_arena::max_concurrency();
   std::size_t level0_groups = (frame.level0_rays + kRayGroup - 1) / kRayGroup;
   std::vector<double> launches = mock.launch_ms;
   std::sort(launches.begin(), launches.end());
-  for (std::size_t k = level0_groups; k < launches.size(); ++k) EXPECT_LT(launches[k], deadline);
+  for (std::size_t k = level0_groups; k < launches.size(); ++k) EXPECT_LT(launches[k], deadline + workers * group_ms);
+  // Work stops within one group per worker of the deadline.
+  EXPECT_LE(mock.now_ms(), deadline + workers * group_ms);
+  EXPECT_GE(mock.now_ms(), deadline);
   EXPECT_EQ(frame.rays_traced, mock.traced());
   // Priority order up to bucket granularity.
   const FractalPattern p = make_fractal_pattern(kW, kH, 8);
