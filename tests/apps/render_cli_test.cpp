@@ -17,24 +17,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int code = -1;
-  std::string err;
-};
+using test::CliRun;
 
-/// Runs raysift in `dir`; stdout/stderr go to stdout<tag>.txt / stderr<tag>.txt.
-CliRun raysift(const std::string& dir, const std::string& args, const std::string& tag = "") {
-  const std::string cmd = "cd '" + dir + "' && '" + RAYSIFT_EXE + "' " + args + " >stdout" + tag + ".txt 2>stderr" +
-                          tag + ".txt";
-  const int status = std::system(cmd.c_str());
-  CliRun r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream in(dir + "/stderr" + tag + ".txt");
-  std::stringstream s;
-  s << in.rdbuf();
-  r.err = s.str();
-  return r;
-}
+CliRun raysift(const std::string& dir, const std::string& args) { return test::run_cli(RAYSIFT_EXE, dir, args); }
 
 const std::string kDatasets = std::string(RAYSIFT_SOURCE_DIR) + "/datasets";
 
@@ -123,14 +108,11 @@ TEST(RenderCli, BadInputFailsWithoutOutput) {
       {"--tf tf.json --camera cam_flat.json", 1, "cam_flat.json"},
       {"--tf missing.json", 1, "missing.json"},
   };
-  // Concurrent: process start-up (hundreds of shared libraries) dominates each run.
-  std::vector<std::future<CliRun>> runs;
-  for (std::size_t i = 0; i < std::size(cases); ++i)
-    runs.push_back(std::async(std::launch::async, [&, i] {
-      return raysift(dir, "render ball.vdb --width 8 --height 8 -o out.exr " + cases[i].args, std::to_string(i));
-    }));
+  std::vector<std::string> args;
+  for (const auto& c : cases) args.push_back("render ball.vdb --width 8 --height 8 -o out.exr " + c.args);
+  const std::vector<CliRun> runs = test::run_cli_all(RAYSIFT_EXE, dir, args);
   for (std::size_t i = 0; i < std::size(cases); ++i) {
-    const CliRun r = runs[i].get();
+    const CliRun& r = runs[i];
     EXPECT_EQ(r.code, cases[i].code) << cases[i].args << ": " << r.err;
     EXPECT_NE(r.err.find(cases[i].message), std::string::npos) << cases[i].args << ": " << r.err;
   }
