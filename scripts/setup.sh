@@ -28,7 +28,7 @@ cmake --build build -j2
 case "$mode" in
   demo)
     ./build/raysift info datasets/engine_ct.vdb
-    ./build/raysift render --scene datasets/engine_ct_scene.json -o build/demo.png --stats build/demo_stats.json
+    ./build/raysift render --scene datasets/engine_ct_scene.json --shading phong -o build/demo.png --stats build/demo_stats.json
     echo "demo: wrote build/demo.png (stats: build/demo_stats.json)"
     ;;
   test)
