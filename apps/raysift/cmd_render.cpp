@@ -14,6 +14,7 @@
 #include "core/progress.h"
 #include "core/scene.h"
 #include "core/timer.h"
+#include "sampling/camera_path.h"
 #include "sampling/volume_sampling.h"
 #include "volume/raycaster.h"
 #include "volume/transfer_function.h"
@@ -247,6 +248,51 @@ void trace_one_pixel(const std::string& text, const volume::RayCaster& caster) {
               x, y, r.color.r, r.color.g, r.color.b, r.color.a, c.r, c.g, c.b, r.depth, r.samples);
 }
 
+// Camera paths (sampling/camera_path.h, issue 9): --camera-path, --target-fps, --compare-full and the
+// "saliency" entry of --features. The whole path is rendered by run_path_request.
+struct PathCliOptions {
+  std::string camera_path;
+  double target_fps = 0;
+  CLI::Option* target_fps_option = nullptr;  ///< to reject an explicit --target-fps 0
+  bool compare_full = false;
+  bool use_saliency = false;                 ///< "saliency" taken out of --features before the lines parse it
+};
+
+/// Checks the path flags and takes "saliency" out of --features (before build_inputs parses the classes).
+void prepare_path_flags(PathCliOptions& p, RenderCliOptions& o) {
+  if (p.target_fps_option->count() > 0 && !(std::isfinite(p.target_fps) && p.target_fps > 0))
+    bad_flag("--target-fps", "a number > 0 (frames per second)", std::to_string(p.target_fps));
+  o.features = sampling::split_saliency_feature(o.features, p.use_saliency);
+  if (p.camera_path.empty()) {
+    if (p.target_fps > 0 || p.use_saliency || p.compare_full)
+      throw UsageError("--target-fps, --compare-full and --features saliency need --camera-path; see --help");
+    return;
+  }
+  if (!sampling::is_frame_pattern(o.out))
+    bad_flag("-o/--out", "a frame pattern such as frame_%03d.png with --camera-path", o.out);
+  if (o.progressive > 0 || !o.pixel.empty() || !o.feature_mesh.empty())
+    throw UsageError("--progressive, --pixel and --feature-mesh apply to single frames, not to --camera-path "
+                     "(a path refines by itself while consecutive cameras are equal); see --help");
+}
+
+void render_path(const PathCliOptions& p, const RenderCliOptions& o, const RenderInputs& in, const CommonOptions& common) {
+  sampling::PathRenderRequest request;
+  request.camera_path = p.camera_path;
+  request.out_pattern = o.out;
+  request.options.sampling = in.sampled.sampling;
+  request.options.features.lines = in.sampled.features;
+  request.options.features.use_saliency = p.use_saliency;
+  request.options.target_fps = p.target_fps;
+  request.options.compare_full = p.compare_full;
+  request.geometry = in.sampled.geometry;
+  Json stats = sampling::run_path_request(in.volume, *in.tf, in.options, in.camera, request);
+  stats["mode"] = o.mode;
+  if (common.verbose)
+    std::cerr << "rendered " << stats.at("frames").size() << " frames to " << o.out << " in "
+              << stats.at("times_ms").at("total").get<double>() << " ms\n";
+  write_stats_if_requested(common, stats);
+}
+
 RegisterCommand reg(
     "render", "volume ray casting (emission-absorption, transfer function, empty-space skipping)",
     [](CLI::App& sub, CommonOptions& common) -> RunFunction {
@@ -292,10 +338,20 @@ RegisterCommand reg(
           "-o engine.exr --stats stats.json\n"
           "  raysift render --scene datasets/engine_ct_scene.json --mode prioritized --ray-fraction 0.2 -o p.exr\n"
           "  raysift render --scene datasets/engine_ct_scene.json --mode subsample --ray-fraction 0.2 -o s.exr");
-      return [opt, &common] {
+      auto path = std::make_shared<PathCliOptions>();
+      sub.add_option("--camera-path", path->camera_path,
+                     "render a sequence: JSON list of cameras, {\"cameras\": [...]} or {\"orbit\": {centre, radius, "
+                     "elevation_deg, frames}}; -o is then a pattern such as frame_%03d.png; --features may add saliency");
+      path->target_fps_option = sub.add_option("--target-fps", path->target_fps,
+                                               "camera path, prioritized: adapt alpha00 to hold this frame rate (> 0)");
+      sub.add_flag("--compare-full", path->compare_full,
+                   "camera path: also render every frame fully (untimed) and report ssim_vs_full per frame");
+      return [opt, path, &common] {
         const Timer total;
+        prepare_path_flags(*path, *opt);
         validate(*opt);
         const RenderInputs in = build_inputs(*opt, common);
+        if (!path->camera_path.empty()) return render_path(*path, *opt, in, common);
         const volume::RayCaster caster(in.volume, *in.tf, in.camera, in.options);
         const double setup_ms = total.elapsed_ms();
         if (common.verbose) std::cerr << echo_command(*opt, in, common) << "\n";
