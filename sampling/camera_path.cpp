@@ -430,7 +430,9 @@ Json run_path_request(const volume::Volume& volume, const volume::TransferFuncti
   const std::vector<CameraSpec> cameras = load_camera_path(request.camera_path, camera);
   const Timer setup;
   std::optional<FeatureGeometry> geometry;
-  if (!request.options.features.lines.classes.is_empty()) geometry = build_feature_geometry(volume, tf, request.geometry);
+  if (!request.options.features.lines.classes.is_empty())
+    geometry = request.feature_mesh.empty() ? build_feature_geometry(volume, tf, request.geometry)
+                                            : load_feature_geometry(request.feature_mesh);
   const double setup_ms = setup.elapsed_ms();
   const auto frames = render_camera_path(volume, tf, render, cameras, geometry ? &*geometry : nullptr, request.options,
                                          [&](const PathFrame& frame, const ImageRGBA& image) {

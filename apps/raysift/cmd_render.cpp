@@ -270,8 +270,8 @@ void prepare_path_flags(PathCliOptions& p, RenderCliOptions& o) {
   }
   if (!sampling::is_frame_pattern(o.out))
     bad_flag("-o/--out", "a frame pattern such as frame_%03d.png with --camera-path", o.out);
-  if (o.progressive > 0 || !o.pixel.empty() || !o.feature_mesh.empty())
-    throw UsageError("--progressive, --pixel and --feature-mesh apply to single frames, not to --camera-path "
+  if (o.progressive > 0 || !o.pixel.empty())
+    throw UsageError("--progressive and --pixel apply to single frames, not to --camera-path "
                      "(a path refines by itself while consecutive cameras are equal); see --help");
 }
 
@@ -285,6 +285,7 @@ void render_path(const PathCliOptions& p, const RenderCliOptions& o, const Rende
   request.options.target_fps = p.target_fps;
   request.options.compare_full = p.compare_full;
   request.geometry = in.sampled.geometry;
+  request.feature_mesh = in.sampled.feature_mesh;
   Json stats = sampling::run_path_request(in.volume, *in.tf, in.options, in.camera, request);
   stats["mode"] = o.mode;
   if (common.verbose)
