@@ -333,10 +333,11 @@ std::vector<PathFrame> render_camera_path(const volume::Volume& volume, const vo
   float alpha00 = options.sampling.mapping.alpha[0];
   int still_frames = 0;  // frames since the camera stopped, after the first
   FrameTiming last_timing;
+  const auto bricks = volume::build_volume_bricks(volume);  // view-independent: once per path
   for (std::size_t i = 0; i < cameras.size(); ++i) {
     const CameraSpec& spec = cameras[i];
     // Building the caster stands in for an interactive camera update; it is not part of the frame time.
-    const volume::RayCaster caster(volume, tf, spec, render);
+    const volume::RayCaster caster(volume, bricks, tf, spec, render);
     const int w = caster.width(), h = caster.height();
     PathFrame frame;
     frame.index = int(i);

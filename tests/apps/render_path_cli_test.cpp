@@ -1,7 +1,6 @@
 // `raysift render --camera-path`: an orbit writes one frame per camera and per-frame stats; --features
 // saliency and --target-fps are accepted on a path; bad paths and flags fail with exit codes 1 / 2.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <fstream>
 #include <sstream>
@@ -14,20 +13,10 @@
 namespace raysift {
 namespace {
 
-struct PathRun {
-  int code = -1;
-  std::string err;
-};
-
-PathRun render(const std::string& dir, const std::string& args) {
-  const std::string cmd = "cd '" + dir + "' && '" + RAYSIFT_EXE + "' render " + std::string(RAYSIFT_SOURCE_DIR) +
-                          "/datasets/engine_ct.vdb --tf " + RAYSIFT_SOURCE_DIR + "/datasets/engine_ct_tf.json " + args +
-                          " >stdout.txt 2>stderr.txt";
-  const int status = std::system(cmd.c_str());
-  std::ifstream in(dir + "/stderr.txt");
-  std::stringstream s;
-  s << in.rdbuf();
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, s.str()};
+/// Renders the bundled engine CT with its TF plus `args` inside `dir`.
+test::CliRun render(const std::string& dir, const std::string& args) {
+  const std::string data = std::string(RAYSIFT_SOURCE_DIR) + "/datasets/";
+  return test::run_cli(RAYSIFT_EXE, dir, "render " + data + "engine_ct.vdb --tf " + data + "engine_ct_tf.json " + args);
 }
 
 void write_orbit(const std::string& path, int frames) {
@@ -39,7 +28,7 @@ void write_orbit(const std::string& path, int frames) {
 TEST(RenderPathCli, OrbitWritesEveryFrameWithStats) {
   const std::string dir = test::make_temp_dir("render_path_cli");
   write_orbit(dir + "/orbit.json", 3);
-  const PathRun r = render(dir, "--camera-path orbit.json --mode prioritized --ray-fraction 0.3 --features saliency "
+  const test::CliRun r = render(dir, "--camera-path orbit.json --mode prioritized --ray-fraction 0.3 --features saliency "
                                 "--target-fps 50 --compare-full -o f_%02d.exr --stats stats.json");
   ASSERT_EQ(r.code, 0) << r.err;
   for (const char* name : {"f_00.exr", "f_01.exr", "f_02.exr"}) {
@@ -62,7 +51,7 @@ TEST(RenderPathCli, BadPathsAndFlagsFail) {
   const std::string dir = test::make_temp_dir("render_path_cli_bad");
   write_orbit(dir + "/zero.json", 0);
   write_orbit(dir + "/two.json", 2);
-  PathRun r = render(dir, "--camera-path zero.json -o f_%02d.exr");
+  test::CliRun r = render(dir, "--camera-path zero.json -o f_%02d.exr");
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("zero.json"), std::string::npos) << r.err;
   r = render(dir, "--camera-path two.json --mode prioritized --target-fps 0 -o f_%02d.exr");

@@ -15,16 +15,8 @@
 namespace raysift {
 namespace {
 
-struct RunResult {
-  int exit_code;
-  std::string err;
-};
-
-RunResult run(const std::string& args, const std::string& dir) {
-  const std::string err_path = dir + "/stderr.txt";
-  const int status = std::system((std::string(RAYSIFT_EXE) + " saliency " + args + " 2>" + err_path).c_str());
-  std::ifstream in(err_path);
-  return {WEXITSTATUS(status), std::string(std::istreambuf_iterator<char>(in), {})};
+test::CliRun run(const std::string& args, const std::string& dir) {
+  return test::run_cli(RAYSIFT_EXE, dir, "saliency " + args);
 }
 
 std::string disc_png(const std::string& dir) {
@@ -40,8 +32,8 @@ std::string disc_png(const std::string& dir) {
 TEST(SaliencyCli, WritesMapOfScaledSizeAndStats) {
   const std::string dir = test::make_temp_dir("saliency_cli");
   const std::string in = disc_png(dir);
-  const RunResult r = run(in + " -o " + dir + "/map.exr --scale 0.5 --stats " + dir + "/stats.json", dir);
-  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const test::CliRun r = run(in + " -o " + dir + "/map.exr --scale 0.5 --stats " + dir + "/stats.json", dir);
+  ASSERT_EQ(r.code, 0) << r.err;
   const ImageF map = read_image_float(dir + "/map.exr");
   EXPECT_EQ(map.width, 80);
   EXPECT_EQ(map.height, 64);
@@ -61,16 +53,16 @@ TEST(SaliencyCli, BadInputFailsWithMessageAndNoOutput) {
   const std::string dir = test::make_temp_dir("saliency_cli_bad");
   const std::string in = disc_png(dir);
   const std::string out = dir + "/map.exr";
-  RunResult r = run(dir + "/missing.png -o " + out, dir);
-  EXPECT_EQ(r.exit_code, 1);
+  test::CliRun r = run(dir + "/missing.png -o " + out, dir);
+  EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("missing.png"), std::string::npos) << r.err;
   r = run(in + " -o " + out + " --scale 1.5", dir);
-  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--scale"), std::string::npos) << r.err;
   r = run(in + " -o " + dir + "/map.tif", dir);
-  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.code, 2);
   r = run(in + " -o " + out + " --scale 0.05", dir);  // 8x6 px map: too small
-  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("disc.png"), std::string::npos) << r.err;
   EXPECT_FALSE(std::ifstream(out).good());
 }
