@@ -265,7 +265,7 @@ void prepare_path_flags(PathCliOptions& p, RenderCliOptions& o) {
   o.features = sampling::split_saliency_feature(o.features, p.use_saliency);
   if (p.camera_path.empty()) {
     if (p.target_fps > 0 || p.use_saliency || p.compare_full)
-      throw UsageError("--target-fps, --compare-full and --features saliency need --camera-path; see --help");
+      throw UsageError("--target-fps, --reference/--compare-full and --features saliency need --camera-path; see --help");
     return;
   }
   if (!sampling::is_frame_pattern(o.out))
@@ -345,7 +345,7 @@ RegisterCommand reg(
                      "elevation_deg, frames}}; -o is then a pattern such as frame_%03d.png; --features may add saliency");
       path->target_fps_option = sub.add_option("--target-fps", path->target_fps,
                                                "camera path, prioritized: adapt alpha00 to hold this frame rate (> 0)");
-      sub.add_flag("--compare-full", path->compare_full,
+      sub.add_flag("--reference,--compare-full", path->compare_full,
                    "camera path: also render every frame fully (untimed) and report ssim_vs_full per frame");
       return [opt, path, &common] {
         const Timer total;
