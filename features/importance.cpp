@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/errors.h"
+#include "core/parallel.h"
 #include "core/timer.h"
 #include "features/detail/distance_transform.h"
 #include "features/detail/segment_raster.h"
@@ -50,17 +51,6 @@ void for_pixels(int width, int height, bool threaded, const F& f) {
   }
 }
 
-template <typename F>
-void for_rows(int height, bool threaded, const F& f) {
-  if (threaded) {
-    tbb::parallel_for(tbb::blocked_range<int>(0, height, 8), [&](const tbb::blocked_range<int>& r) {
-      for (int y = r.begin(); y != r.end(); ++y) f(y);
-    });
-  } else {
-    for (int y = 0; y < height; ++y) f(y);
-  }
-}
-
 /// Slab test: does the ray hit the box at some t >= 0 (a camera inside the box always hits)? The direction
 /// need not have unit length.
 bool ray_hits_box(const Ray& ray, const Bbox3d& box) {
@@ -93,14 +83,14 @@ Image<std::uint8_t> coverage(const Camera& camera, const BackgroundGeometry& bg,
     auto hits_box = [&](int x, int y) {
       return ray_hits_box({camera.eye(), camera.direction_unit_depth(x + 0.5, y + 0.5)}, *bg.bbox_ws);
     };
-    for_rows(h, threaded, [&](int y) {
+    parallel_rows(h, [&](int y) {
       int left = 0;
       while (left < w && !hits_box(left, y)) ++left;
       if (left == w) return;
       int right = w - 1;
       while (right > left && !hits_box(right, y)) --right;
       std::fill(&hit(left, y), &hit(right, y) + 1, std::uint8_t(1));
-    });
+    }, threaded);
   }
   if (mesh_frame_depth) {
     const ImageF& d = mesh_frame_depth->depth;

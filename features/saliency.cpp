@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/parallel.h"
 
 namespace raysift::features {
 namespace {
@@ -35,17 +36,6 @@ constexpr int kGaborRadius = 4;           // 9x9 kernel [choice]
 constexpr double kGaborWavelengthPx = 4;  // [choice]
 constexpr double kGaborSigmaPx = 2;       // [choice]
 constexpr int kOrientations = 4;          // 0, 45, 90, 135 degrees
-
-template <typename F>
-void for_rows(int height, bool threaded, const F& row) {
-  if (!threaded) {
-    for (int y = 0; y < height; ++y) row(y);
-    return;
-  }
-  tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& r) {
-    for (int y = r.begin(); y < r.end(); ++y) row(y);
-  });
-}
 
 template <typename F>
 void for_items(int count, bool threaded, const F& item) {
@@ -132,7 +122,7 @@ std::array<Plane, 3> downscale_rgb(const ImageRGBA& image, int w, int h, bool th
   const AxisTaps ty = box_taps(image.height, h);
   std::array<Plane, 3> out;
   for (Plane& p : out) p = Plane(w, h, 0.f);
-  for_rows(h, threaded, [&](int y) {
+  parallel_rows(h, [&](int y) {
     float* r = &out[0](0, y);
     float* g = &out[1](0, y);
     float* b = &out[2](0, y);
@@ -153,7 +143,7 @@ std::array<Plane, 3> downscale_rgb(const ImageRGBA& image, int w, int h, bool th
         b[x] += wy * ab;
       }
     }
-  });
+  }, threaded);
   return out;
 }
 
@@ -180,7 +170,7 @@ void rgb_to_lab(std::array<Plane, 3>& planes, bool threaded) {
     return t > kDelta * kDelta * kDelta ? cube_root(t) : t / (3.0 * kDelta * kDelta) + 4.0 / 29.0;
   };
   const int w = planes[0].width;
-  for_rows(planes[0].height, threaded, [&](int y) {
+  parallel_rows(planes[0].height, [&](int y) {
     for (int x = 0; x < w; ++x) {
       // Negative linear values (out-of-gamut renders) have no colorimetric meaning: clamp to black.
       const double r = std::max(0.0f, planes[0](x, y));
@@ -193,7 +183,7 @@ void rgb_to_lab(std::array<Plane, 3>& planes, bool threaded) {
       planes[1](x, y) = float(500.0 * (fx - fy));
       planes[2](x, y) = float(200.0 * (fy - fz));
     }
-  });
+  }, threaded);
 }
 
 /// One pyramid step: separable [1 4 6 4 1]/16 blur, keeping every second pixel (borders replicated).
@@ -201,21 +191,21 @@ Plane reduce(const Plane& in, bool threaded) {
   static constexpr float kTaps[5] = {1.f / 16, 4.f / 16, 6.f / 16, 4.f / 16, 1.f / 16};
   const int w = (in.width + 1) / 2, h = (in.height + 1) / 2;
   Plane horizontal(w, in.height);
-  for_rows(in.height, threaded, [&](int y) {
+  parallel_rows(in.height, [&](int y) {
     for (int x = 0; x < w; ++x) {
       float acc = 0;
       for (int k = -2; k <= 2; ++k) acc += kTaps[k + 2] * in(std::clamp(2 * x + k, 0, in.width - 1), y);
       horizontal(x, y) = acc;
     }
-  });
+  }, threaded);
   Plane out(w, h);
-  for_rows(h, threaded, [&](int y) {
+  parallel_rows(h, [&](int y) {
     for (int x = 0; x < w; ++x) {
       float acc = 0;
       for (int k = -2; k <= 2; ++k) acc += kTaps[k + 2] * horizontal(x, std::clamp(2 * y + k, 0, in.height - 1));
       out(x, y) = acc;
     }
-  });
+  }, threaded);
   return out;
 }
 
@@ -293,7 +283,7 @@ Plane gabor_energy(const Plane& lum, const Kernel& kernel, bool threaded) {
     for (int x = 0; x < pw; ++x)
       padded(x, y) = lum(std::clamp(x - kGaborRadius, 0, lum.width - 1), std::clamp(y - kGaborRadius, 0, lum.height - 1));
   Plane out(lum.width, lum.height);
-  for_rows(lum.height, threaded, [&](int y) {
+  parallel_rows(lum.height, [&](int y) {
     float* acc = &out(0, y);
     std::fill(acc, acc + lum.width, 0.f);
     for (int j = 0; j < kSide; ++j) {
@@ -304,7 +294,7 @@ Plane gabor_energy(const Plane& lum, const Kernel& kernel, bool threaded) {
       }
     }
     for (int x = 0; x < lum.width; ++x) acc[x] = std::abs(acc[x]);
-  });
+  }, threaded);
   return out;
 }
 

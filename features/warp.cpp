@@ -1,8 +1,5 @@
 #include "features/warp.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -15,22 +12,12 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/parallel.h"
 
 namespace raysift::features {
 namespace {
 
 constexpr std::uint64_t kEmpty = std::numeric_limits<std::uint64_t>::max();
-
-template <typename F>
-void for_rows(int height, bool threaded, const F& row) {
-  if (!threaded) {
-    for (int y = 0; y < height; ++y) row(y);
-    return;
-  }
-  tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& r) {
-    for (int y = r.begin(); y < r.end(); ++y) row(y);
-  });
-}
 
 bool has_depth(float t) { return std::isfinite(t) && t > 0.f; }
 
@@ -97,7 +84,7 @@ WarpResult warp_map(const ImageF& map, const ImageF& depth_ray, const Camera& pr
 
   std::unique_ptr<std::atomic<std::uint64_t>[]> winner(new std::atomic<std::uint64_t>[n]);
   for (std::size_t i = 0; i < n; ++i) winner[i].store(kEmpty, std::memory_order_relaxed);
-  for_rows(h, threaded, [&](int y) {
+  parallel_rows(h, [&](int y) {
     for (int x = 0; x < w; ++x) {
       const std::size_t src = std::size_t(y) * std::size_t(w) + std::size_t(x);
       const float t = depth_ray.pixels[src];
@@ -111,7 +98,7 @@ WarpResult warp_map(const ImageF& map, const ImageF& depth_ray, const Camera& pr
       const std::size_t dst = std::size_t(oy) * std::size_t(w) + std::size_t(ox);
       atomic_min(winner[dst], pack(float(p->depth), std::uint32_t(src)));
     }
-  });
+  }, threaded);
 
   enum Origin : std::uint8_t { kSplatted, kHoleClosed, kDisoccluded };
   std::vector<std::uint8_t> origin(n);
@@ -122,7 +109,7 @@ WarpResult warp_map(const ImageF& map, const ImageF& depth_ray, const Camera& pr
   const auto value_of = [&](std::size_t i) {
     return map.pixels[std::size_t(winner[i].load(std::memory_order_relaxed) & 0xffffffffu)];
   };
-  for_rows(h, threaded, [&](int y) {
+  parallel_rows(h, [&](int y) {
     for (int x = 0; x < w; ++x) {
       const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
       if (is_filled(i)) {
@@ -143,7 +130,7 @@ WarpResult warp_map(const ImageF& map, const ImageF& depth_ray, const Camera& pr
         }
       }
     }
-  });
+  }, threaded);
   for (std::uint8_t o : origin) ++(o == kSplatted ? result.n_splatted : o == kHoleClosed ? result.n_hole_closed
                                                                                          : result.n_disoccluded);
   return result;
@@ -164,7 +151,7 @@ ImageF downsample_depth(const ImageF& depth_ray, int width, int height, bool thr
   ImageF out(width, height);
   // Integer block bounds floor(i*W/w) .. floor((i+1)*W/w)-1 tile the input exactly; none is empty as w <= W.
   const auto lo = [](int i, int n_in, int n_out) { return int(std::int64_t(i) * n_in / n_out); };
-  for_rows(height, threaded, [&](int y) {
+  parallel_rows(height, [&](int y) {
     const int y0 = lo(y, depth_ray.height, height), y1 = lo(y + 1, depth_ray.height, height);
     for (int x = 0; x < width; ++x) {
       const int x0 = lo(x, depth_ray.width, width), x1 = lo(x + 1, depth_ray.width, width);
@@ -176,7 +163,7 @@ ImageF downsample_depth(const ImageF& depth_ray, int width, int height, bool thr
         }
       out(x, y) = nearest;
     }
-  });
+  }, threaded);
   return out;
 }
 

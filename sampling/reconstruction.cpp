@@ -1,11 +1,10 @@
 #include "sampling/reconstruction.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
+
+#include "core/parallel.h"
 
 namespace raysift::sampling {
 namespace {
@@ -77,13 +76,6 @@ bool cell_corners(int x, int y, int state, int spacing, int w, int h, std::array
   return true;
 }
 
-template <typename Fn>
-void for_each_row(int height, Fn&& fn) {
-  tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
-    for (int y = rows.begin(); y < rows.end(); ++y) fn(y);
-  });
-}
-
 }  // namespace
 
 void reconstruct_fractal(ImageRGBA& image, const ImageMask& known, const FractalPattern& pattern) {
@@ -94,7 +86,7 @@ void reconstruct_fractal(ImageRGBA& image, const ImageMask& known, const Fractal
   // Pass 1: complete anchors whose four parents were traced. Reads only `known` pixels, writes only
   // unknown ones, so rows are independent.
   ImageMask available = known;
-  for_each_row(h, [&](int y) {
+  parallel_rows(h, [&](int y) {
     for (int x = 0; x < w; ++x) {
       if (known(x, y)) continue;
       const int level = pattern.level(x, y);
@@ -116,7 +108,7 @@ void reconstruct_fractal(ImageRGBA& image, const ImageMask& known, const Fractal
   });
 
   // Pass 2: interpolate the rest from the finest complete cell. Reads only `available` pixels.
-  for_each_row(h, [&](int y) {
+  parallel_rows(h, [&](int y) {
     for (int x = 0; x < w; ++x) {
       if (available(x, y)) continue;
       const int level = pattern.level(x, y);
@@ -199,7 +191,7 @@ void reconstruct_bilinear(ImageRGBA& image, const SampleGrid& grid, const ImageM
   std::vector<std::uint8_t> is_col(image.width, 0), is_row(image.height, 0);
   for (int x : grid.xs) is_col[x] = 1;
   for (int y : grid.ys) is_row[y] = 1;
-  for_each_row(image.height, [&](int y) {
+  parallel_rows(image.height, [&](int y) {
     for (int x = 0; x < image.width; ++x) {
       if ((is_col[x] && is_row[y]) || fixed(x, y)) continue;
       const float u = ax.t[x], v = ay.t[y];
