@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "apps/raysift/command.h"
+#include "apps/raysift/volume_input.h"
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/scene.h"
@@ -19,7 +20,6 @@
 #include "volume/iso_values.h"
 #include "volume/marching_cubes.h"
 #include "volume/transfer_function.h"
-#include "volume/vdb_io.h"
 
 namespace raysift::app {
 namespace {
@@ -93,28 +93,13 @@ std::string echo_command(const MeshCliOptions& o, const std::vector<double>& iso
 
 void run(const MeshCliOptions& o, const CommonOptions& common, CLI::App& sub) {
   validate(o, sub);
-  Scene scene;
-  if (!common.scene_path.empty()) scene = load_scene(common.scene_path);
-  const std::string volume_path = !o.volume.empty() ? o.volume : scene.volume;
-  if (volume_path.empty()) throw UsageError("mesh needs a VOLUME argument or a --scene with a 'volume'; see --help");
-  const volume::Volume vol = volume::load_vdb(volume_path, !o.grid.empty() ? o.grid : scene.grid);
-  const volume::GridInfo info = vol.info();
-
-  volume::TfJsonOptions tf_options;
-  tf_options.normalized = o.tf_normalized;
-  tf_options.data_min = info.value_min;
-  tf_options.data_max = info.value_max;
-  std::unique_ptr<volume::TransferFunction> tf;
-  std::string tf_source = o.tf;
-  if (!o.tf.empty()) {
-    tf = std::make_unique<volume::TransferFunction>(volume::load_transfer_function(o.tf, tf_options));
-  } else if (!scene.transfer_function.is_null()) {
-    tf_source = scene.transfer_function_source;
-    tf = std::make_unique<volume::TransferFunction>(
-        volume::transfer_function_from_json(scene.transfer_function, tf_source, tf_options));
-  } else if (o.iso.empty()) {
+  VolumeInput input = load_volume_input(o.volume, o.grid, o.tf, o.tf_normalized, common.scene_path, "mesh");
+  const volume::Volume& vol = input.volume;
+  const volume::GridInfo& info = input.info;
+  const std::unique_ptr<volume::TransferFunction>& tf = input.tf;
+  const std::string& tf_source = input.tf_source;
+  if (!tf && o.iso.empty())
     throw UsageError("mesh needs --tf TF.json (or a --scene with a 'transfer_function') or --iso; see --help");
-  }
 
   std::vector<volume::IsoValue> isos;
   if (tf) {
@@ -207,7 +192,7 @@ void run(const MeshCliOptions& o, const CommonOptions& common, CLI::App& sub) {
     for (const auto& t : r.mesh.triangles) combined.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
   }
   if (combined.empty())
-    throw InvalidInput(file_message(volume_path, "no iso-surface found at the chosen iso-values; nothing written"));
+    throw InvalidInput(file_message(input.volume_path, "no iso-surface found at the chosen iso-values; nothing written"));
   mesh::write_mesh(o.out, combined);
 
   if (common.verbose)

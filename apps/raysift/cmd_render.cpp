@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "apps/raysift/command.h"
+#include "apps/raysift/volume_input.h"
 #include "core/file_util.h"
 #include "core/image.h"
 #include "core/progress.h"
@@ -18,7 +19,6 @@
 #include "sampling/volume_sampling.h"
 #include "volume/raycaster.h"
 #include "volume/transfer_function.h"
-#include "volume/vdb_io.h"
 
 namespace raysift::app {
 namespace {
@@ -150,25 +150,13 @@ void validate(const RenderCliOptions& o) {
 }
 
 RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common) {
-  Scene scene;
-  if (!common.scene_path.empty()) scene = load_scene(common.scene_path);
-  const std::string volume_path = !o.volume.empty() ? o.volume : scene.volume;
-  if (volume_path.empty()) throw UsageError("render needs a VOLUME argument or a --scene with a 'volume'; see --help");
+  VolumeInput input = load_volume_input(o.volume, o.grid, o.tf, o.tf_normalized, common.scene_path, "render");
+  if (!input.tf) throw UsageError("render needs --tf TF.json or a --scene with a 'transfer_function'; see --help");
+  const Scene& scene = input.scene;
+  const volume::GridInfo& info = input.info;
   RenderInputs in;
-  in.volume = volume::load_vdb(volume_path, !o.grid.empty() ? o.grid : scene.grid);
-  const volume::GridInfo info = in.volume.info();
-
-  volume::TfJsonOptions tf_options;
-  tf_options.normalized = o.tf_normalized;
-  tf_options.data_min = info.value_min;
-  tf_options.data_max = info.value_max;
-  if (!o.tf.empty())
-    in.tf = std::make_unique<volume::TransferFunction>(volume::load_transfer_function(o.tf, tf_options));
-  else if (!scene.transfer_function.is_null())
-    in.tf = std::make_unique<volume::TransferFunction>(
-        volume::transfer_function_from_json(scene.transfer_function, scene.transfer_function_source, tf_options));
-  else
-    throw UsageError("render needs --tf TF.json or a --scene with a 'transfer_function'; see --help");
+  in.volume = std::move(input.volume);
+  in.tf = std::move(input.tf);
   if (info.value_max < in.tf->domain_min() || info.value_min > in.tf->domain_max()) {
     if (!common.quiet)
       std::cerr << "raysift: warning: the transfer function's range [" << in.tf->domain_min() << ", "

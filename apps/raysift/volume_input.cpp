@@ -1,0 +1,33 @@
+#include "apps/raysift/volume_input.h"
+
+#include "core/errors.h"
+#include "volume/vdb_io.h"
+
+namespace raysift::app {
+
+VolumeInput load_volume_input(const std::string& volume_arg, const std::string& grid, const std::string& tf_path,
+                              bool tf_normalized, const std::string& scene_path, const std::string& command) {
+  VolumeInput in;
+  if (!scene_path.empty()) in.scene = load_scene(scene_path);
+  in.volume_path = !volume_arg.empty() ? volume_arg : in.scene.volume;
+  if (in.volume_path.empty())
+    throw UsageError(command + " needs a VOLUME argument or a --scene with a 'volume'; see --help");
+  in.volume = volume::load_vdb(in.volume_path, !grid.empty() ? grid : in.scene.grid);
+  in.info = in.volume.info();
+
+  volume::TfJsonOptions tf_options;
+  tf_options.normalized = tf_normalized;
+  tf_options.data_min = in.info.value_min;
+  tf_options.data_max = in.info.value_max;
+  if (!tf_path.empty()) {
+    in.tf_source = tf_path;
+    in.tf = std::make_unique<volume::TransferFunction>(volume::load_transfer_function(tf_path, tf_options));
+  } else if (!in.scene.transfer_function.is_null()) {
+    in.tf_source = in.scene.transfer_function_source;
+    in.tf = std::make_unique<volume::TransferFunction>(
+        volume::transfer_function_from_json(in.scene.transfer_function, in.tf_source, tf_options));
+  }
+  return in;
+}
+
+}  // namespace raysift::app
