@@ -41,6 +41,18 @@ std::vector<std::uint32_t> in_tile_order(const ImageMask& selected) {
   return out;
 }
 
+// Traces every selected pixel in tile order into `frame` (image, traced mask, ray count). The time since
+// `stage` was reset is the priority stage; `stage` then times the trace.
+void trace_selection(const ImageMask& selected, const TraceBatch& trace, SampledFrame& frame, Timer& stage) {
+  const std::vector<std::uint32_t> rays = in_tile_order(selected);
+  frame.priorities_ms = stage.elapsed_ms();
+  stage.reset();
+  trace_all(rays, trace, frame.image);
+  frame.trace_ms = stage.elapsed_ms();
+  mark(rays, frame.traced);
+  frame.rays_traced = rays.size();
+}
+
 std::size_t ray_target(const SamplingOptions& options, std::size_t object, std::size_t level0) {
   const auto wanted = std::size_t(std::llround(options.ray_fraction * double(object)));
   return std::min(object, std::max(level0, wanted));
@@ -115,13 +127,7 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
   if (options.mode == SamplingMode::Full) {
     ImageMask object(w, h, 0);
     for (std::size_t i = 0; i < importance.size(); ++i) object.pixels[i] = importance.pixels[i] >= 0 ? 1 : 0;
-    const std::vector<std::uint32_t> all = in_tile_order(object);
-    frame.priorities_ms = stage.elapsed_ms();
-    stage.reset();
-    trace_all(all, trace, frame.image);
-    frame.trace_ms = stage.elapsed_ms();
-    mark(all, frame.traced);
-    frame.rays_traced = all.size();
+    trace_selection(object, trace, frame, stage);
     return frame;
   }
 
@@ -130,15 +136,9 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
     ImageMask on_grid(w, h, 0);
     for (int y : grid.ys)
       for (int x : grid.xs) on_grid(x, y) = importance(x, y) >= 0 ? 1 : 0;
-    const std::vector<std::uint32_t> rays = in_tile_order(on_grid);
-    frame.priorities_ms = stage.elapsed_ms();
+    trace_selection(on_grid, trace, frame, stage);
     stage.reset();
-    trace_all(rays, trace, frame.image);
-    frame.trace_ms = stage.elapsed_ms();
-    mark(rays, frame.traced);
-    frame.rays_traced = rays.size();
-    stage.reset();
-    if (rays.size() < counts.object) reconstruct_bilinear(frame.image, grid, background_known(importance));
+    if (frame.rays_traced < counts.object) reconstruct_bilinear(frame.image, grid, background_known(importance));
     frame.reconstruct_ms = stage.elapsed_ms();
     return frame;
   }
@@ -162,13 +162,9 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
     mark(Span<const std::uint32_t>(queue.pixels.data(), frame.rays_traced), frame.traced);
   } else {
     queue = select_top_rays(importance, pattern, options.mapping, target, options.seed, options.threshold);
-    mark(queue.pixels, frame.traced);
-    const std::vector<std::uint32_t> rays = in_tile_order(frame.traced);
-    frame.priorities_ms = stage.elapsed_ms();
-    stage.reset();
-    trace_all(rays, trace, frame.image);
-    frame.rays_traced = rays.size();
-    frame.trace_ms = stage.elapsed_ms();
+    ImageMask selected(w, h, 0);
+    mark(queue.pixels, selected);
+    trace_selection(selected, trace, frame, stage);
   }
 
   stage.reset();
