@@ -7,6 +7,7 @@
 #include "core/errors.h"
 #include "core/timer.h"
 #include "mesh/mesh_io.h"
+#include "volume/iso_visibility.h"
 #include "volume/resample.h"
 
 namespace raysift::isosurface {
@@ -41,7 +42,7 @@ std::string options_fingerprint(const FeatureGeometryOptions& o, int coarsening,
   s << "feature-geometry v1;iso=";
   for (const double v : o.iso_values) s << v << ',';
   s << ";max_surfaces=" << o.max_surfaces << ";smooth=" << o.smooth_iterations << ";ratio=" << o.decimate_ratio
-    << ";coarsening=" << coarsening << ";max_error=" << max_error;
+    << ";coarsening=" << coarsening << ";max_error=" << max_error << ";drop_hidden=" << o.drop_hidden;
   return s.str();
 }
 
@@ -55,6 +56,21 @@ PipelineOptions pipeline_options(const FeatureGeometryOptions& o, double max_err
   p.cancel = o.cancel;
   p.progress = o.progress;
   return p;
+}
+
+/// Moves the iso-values no probe ray can see from `isos` to `hidden` (all stay if none is visible). The probe
+/// runs on a level of at least 2 voxels per cell: a visibility verdict needs no finer cells.
+void split_hidden(const volume::Volume& volume, const volume::Volume& level, int coarsening,
+                  const volume::TransferFunction& tf, std::vector<double>& isos, std::vector<double>& hidden) {
+  const int probe_factor = std::max(2, coarsening);
+  const volume::Volume probe = coarsening >= 2 ? level : volume::downsample(volume, probe_factor);
+  volume::IsoVisibilityOptions o;
+  o.voxel_length = probe_factor;
+  const std::vector<bool> visible = volume::visible_iso_surfaces(probe, tf, isos, o);
+  if (std::none_of(visible.begin(), visible.end(), [](bool v) { return v; })) return;
+  std::vector<double> kept;
+  for (std::size_t k = 0; k < isos.size(); ++k) (visible[k] ? kept : hidden).push_back(isos[k]);
+  isos = std::move(kept);
 }
 
 }  // namespace
@@ -106,6 +122,7 @@ FeatureGeometry build_feature_geometry(const volume::Volume& volume, const volum
       for (const volume::IsoValue& v : volume::select_iso_values(volume, tf, iso_options))
         chosen.iso_values.push_back(v.value);
     }
+    if (options.drop_hidden) split_hidden(volume, level, geometry.coarsening, tf, chosen.iso_values, geometry.hidden_iso_values);
     const IsosurfaceSet set = build_isosurfaces(level, &tf, pipeline_options(chosen, max_error));
     geometry.mesh = merge_surfaces(set);
     geometry.iso_values = chosen.iso_values;

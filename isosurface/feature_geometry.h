@@ -23,6 +23,7 @@ struct FeatureGeometry {
   mesh::TriMesh mesh;
   mesh::MeshCurvature curvature;
   std::vector<double> iso_values;  ///< the surfaces in `mesh`
+  std::vector<double> hidden_iso_values;  ///< chosen, but hidden by the TF from every probe direction: not built
   int coarsening = 1;              ///< grid level used: cells of this many voxels per axis
   bool from_cache = false;
   double build_ms = 0;             ///< wall time of the whole set-up (cache look-up included)
@@ -44,6 +45,9 @@ struct FeatureGeometryOptions {
   double cell_px = 1.0;            ///< automatic level: the coarsest whose cells project to <= this many importance px
   /// > 0 and a view: simplification also stops once its error would exceed this many importance pixels.
   double max_error_px = 0.5;
+  /// Drop iso-surfaces that the TF hides from every direction (volume/iso_visibility.h), e.g. inside opaque
+  /// material; if the probe finds none visible, all are kept.
+  bool drop_hidden = true;
   std::optional<FeatureView> view;
   const std::atomic<bool>* cancel = nullptr;  ///< see PipelineOptions::cancel
   std::function<void(double)> progress;       ///< see PipelineOptions::progress

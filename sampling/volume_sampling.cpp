@@ -105,6 +105,7 @@ SampledRender render_sampled_volume(const volume::Volume& volume, const volume::
     stats["feature_triangles"] = geometry.mesh.triangles.size();
     stats["iso_values"] = geometry.iso_values;
     stats["feature_coarsening"] = geometry.coarsening;
+    stats["hidden_iso_values"] = geometry.hidden_iso_values;
     stats["feature_cache_hit"] = geometry.from_cache;
   }
   auto fill = [&](const SampledFrame& f, double importance_ms, double total_ms, std::uint64_t samples) {
