@@ -20,17 +20,20 @@ std::uint64_t load_le64(const unsigned char* p) {
   return w;
 }
 
+/// One 8-byte step of both lanes: xxHash64's; the word term does not depend on the state, so it overlaps
+/// the state's multiply chain.
+inline void lane_rounds(std::uint64_t& a, std::uint64_t& b, std::uint64_t w) {
+  a ^= rotl(w * kP2, 31) * kP1;
+  a = rotl(a, 27) * kP1 + kP4;
+  b ^= rotl(w * kQ1, 33) * kQ2;
+  b = rotl(b, 29) * kQ3 + kQ4;
+}
+
 }  // namespace
 
 Hasher128::Hasher128(std::uint64_t seed) : a_(seed + kP1 + kP2), b_(mix64(seed) ^ kQ3) {}
 
-void Hasher128::round(std::uint64_t w) {
-  // xxHash64's 8-byte step; the word term does not depend on the state, so it overlaps the state chain.
-  a_ ^= rotl(w * kP2, 31) * kP1;
-  a_ = rotl(a_, 27) * kP1 + kP4;
-  b_ ^= rotl(w * kQ1, 33) * kQ2;
-  b_ = rotl(b_, 29) * kQ3 + kQ4;
-}
+void Hasher128::round(std::uint64_t w) { lane_rounds(a_, b_, w); }
 
 Hasher128& Hasher128::bytes(const void* data, std::size_t size) {
   const auto* p = static_cast<const unsigned char*>(data);
@@ -42,7 +45,11 @@ Hasher128& Hasher128::bytes(const void* data, std::size_t size) {
     round(pending_);
     pending_ = 0;
   }
-  for (; size >= 8; size -= 8, p += 8) round(load_le64(p));
+  // Local lanes: the members could alias the input bytes, which would force a store and reload per word.
+  std::uint64_t a = a_, b = b_;
+  for (; size >= 8; size -= 8, p += 8) lane_rounds(a, b, load_le64(p));
+  a_ = a;
+  b_ = b;
   for (unsigned i = 0; i < size; ++i) pending_ |= std::uint64_t(p[i]) << (8 * i);
   return *this;
 }

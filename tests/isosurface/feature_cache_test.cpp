@@ -1,6 +1,7 @@
 #include "isosurface/feature_cache.h"
 
 #include <gtest/gtest.h>
+#include <tbb/parallel_for.h>
 
 #include <cstring>
 #include <filesystem>
@@ -76,11 +77,14 @@ TEST(FeatureCache, DiskRoundTripInAFreshObjectIsBitIdentical) {
   Warnings w;
   FeatureCache(dir, w.sink()).store(key, g);
   ASSERT_TRUE(fs::is_regular_file(entry_file(dir, key)));
-  const auto hit = FeatureCache(dir, w.sink()).find(key);
+  FeatureCache fresh(dir, w.sink());
+  const auto hit = fresh.find(key);
   ASSERT_TRUE(hit.has_value());
   expect_bit_identical(*hit, g);
   EXPECT_TRUE(w.lines.empty()) << w.lines.front();
   EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1) << "no temporary left behind";
+  fs::remove(entry_file(dir, key));
+  EXPECT_TRUE(fresh.find(key).has_value()) << "a disk hit is kept in memory";
 }
 
 TEST(FeatureCache, FileLayoutIsTheDocumentedOne) {
@@ -104,6 +108,23 @@ TEST(FeatureCache, FileLayoutIsTheDocumentedOne) {
   EXPECT_EQ(u64_at(32), nv);
   EXPECT_EQ(u64_at(40), nt);
   EXPECT_EQ(u64_at(bytes.size() - 8), hash128(bytes.data(), bytes.size() - 8, 0x52534643)[0]);
+}
+
+TEST(FeatureCache, ConcurrentStoresAndFindsAreConsistent) {
+  const std::string dir = test::make_temp_dir("feature_cache");
+  FeatureCache cache(dir);
+  const CachedGeometry g = geometry();
+  tbb::parallel_for(0, 32, [&](int i) {
+    const CacheKey key{3, std::uint64_t(i % 8)};  // 4 threads' worth of collisions per key
+    cache.store(key, g);
+    const auto hit = cache.find(key);
+    EXPECT_TRUE(hit.has_value() && hit->mesh.triangles == g.mesh.triangles);
+  });
+  for (std::uint64_t i = 0; i < 8; ++i) {
+    const auto hit = FeatureCache(dir).find(CacheKey{3, i});
+    ASSERT_TRUE(hit.has_value()) << i;
+    expect_bit_identical(*hit, g);
+  }
 }
 
 std::string key_hex(const volume::Volume& v, const volume::TransferFunction& t, const std::string& options) {
@@ -162,6 +183,12 @@ void damage(const std::string& path, Damage d, const CachedGeometry& g) {
   std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
 }
 
+std::string damage_name(const testing::TestParamInfo<Damage>& info) {
+  static const char* const names[] = {"FlipPayloadByte", "FlipChecksumByte", "Truncate",    "WrongMagic",
+                                      "WrongVersion",    "OtherKeysFile",    "BadIndex"};
+  return names[int(info.param)];
+}
+
 class FeatureCacheDamage : public testing::TestWithParam<Damage> {};
 
 TEST_P(FeatureCacheDamage, DamagedEntryIsIgnoredWithOneWarningAndThenOverwritten) {
@@ -189,7 +216,8 @@ TEST_P(FeatureCacheDamage, DamagedEntryIsIgnoredWithOneWarningAndThenOverwritten
 INSTANTIATE_TEST_SUITE_P(AllKinds, FeatureCacheDamage,
                          testing::Values(Damage::FlipPayloadByte, Damage::FlipChecksumByte, Damage::Truncate,
                                          Damage::WrongMagic, Damage::WrongVersion, Damage::OtherKeysFile,
-                                         Damage::BadIndex));
+                                         Damage::BadIndex),
+                         damage_name);
 
 TEST(FeatureCache, UncreatableDirectoryWarnsOnceAndWorksInMemory) {
   // A path below a regular file cannot be created, even by root (chmod would not stop root).
