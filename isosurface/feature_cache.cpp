@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <type_traits>
 
 #include "core/errors.h"
 #include "core/file_util.h"
@@ -20,7 +21,9 @@ namespace fs = std::filesystem;
 
 // The format is written by memcpy of native values; define it as little-endian and refuse other targets.
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, ".rsfc files are little-endian");
-static_assert(sizeof(Vec3f) == 12 && sizeof(std::array<std::uint32_t, 3>) == 12, "packed payload records");
+static_assert(sizeof(Vec3f) == 12 && sizeof(std::array<std::uint32_t, 3>) == 12 &&
+                  std::is_trivially_copyable_v<Vec3f>,
+              "payload records are copied as packed bytes");
 
 constexpr char kMagic[4] = {'R', 'S', 'F', 'C'};
 constexpr std::uint32_t kFormatVersion = 1;
@@ -114,7 +117,8 @@ std::string decode(const std::string& bytes, const CacheKey& key, CachedGeometry
 
 std::string CacheKey::hex() const {
   char s[33];
-  std::snprintf(s, sizeof s, "%016llx%016llx", static_cast<unsigned long long>(hi), static_cast<unsigned long long>(lo));
+  using ull = unsigned long long;
+  std::snprintf(s, sizeof s, "%016llx%016llx", static_cast<ull>(hi), static_cast<ull>(lo));
   return s;
 }
 

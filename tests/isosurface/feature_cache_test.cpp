@@ -115,7 +115,7 @@ TEST(FeatureCache, ConcurrentStoresAndFindsAreConsistent) {
   FeatureCache cache(dir);
   const CachedGeometry g = geometry();
   tbb::parallel_for(0, 32, [&](int i) {
-    const CacheKey key{3, std::uint64_t(i % 8)};  // 4 threads' worth of collisions per key
+    const CacheKey key{3, std::uint64_t(i % 8)};  // each key stored 4 times, possibly at once
     cache.store(key, g);
     const auto hit = cache.find(key);
     EXPECT_TRUE(hit.has_value() && hit->mesh.triangles == g.mesh.triangles);
@@ -138,7 +138,8 @@ TEST(FeatureCache, KeyFollowsVolumeTfAndOptions) {
 
   const volume::Volume reference = ball();
   const volume::DenseSpec spec{{16, 16, 16}};
-  const auto same_voxels = volume::Volume::from_function(spec, [&](int i, int j, int k) { return reference.value_at({i, j, k}); });
+  const auto same_voxels =
+      volume::Volume::from_function(spec, [&](int i, int j, int k) { return reference.value_at({i, j, k}); });
   EXPECT_EQ(key_hex(same_voxels, tf(), opts), base) << "same voxels built another way";
   const auto one_voxel_changed = volume::Volume::from_function(spec, [&](int i, int j, int k) {
     return (i == 8 && j == 8 && k == 8) ? 0.999f : reference.value_at({i, j, k});

@@ -76,7 +76,8 @@ TEST(ContentHash, EngineSizedGridIsIdenticalFor1And2ThreadsAndSerial) {
   DenseSpec spec;
   spec.dims = {256, 256, 128};
   spec.voxel_size = {0.5, 0.5, 0.75};
-  const Volume v = Volume::from_function(spec, [](int i, int j, int k) { return float((i * 7 + j * 13 + k * 29) % 251 + 1); });
+  const Volume v =
+      Volume::from_function(spec, [](int i, int j, int k) { return float((i * 7 + j * 13 + k * 29) % 251 + 1); });
   ASSERT_EQ(v.active_voxel_count(), 256u * 256u * 128u);
   Hash128 one, two;
   {
