@@ -2,6 +2,7 @@
 
 #include <openvdb/tree/LeafManager.h>
 
+#include <cstring>
 #include <sstream>
 #include <vector>
 
@@ -63,7 +64,11 @@ Hash128 content_hash(const Volume& volume, bool threaded) {
   openvdb::tree::LeafManager<const Tree> leaves(tree);
   std::vector<Hash128> leaf_digests(leaves.leafCount());
   parallel_rows(
-      int(leaves.leafCount()), [&](int i) { leaf_digests[std::size_t(i)] = leaf_hash(leaves.leaf(std::size_t(i))); },
+      int(leaves.leafCount()),
+      [&](int i) {
+        const Leaf& leaf = leaves.leaf(std::size_t(i));
+        if (!leaf.isEmpty()) leaf_digests[std::size_t(i)] = leaf_hash(leaf);
+      },
       threaded);
   // Leaves without active voxels read as background everywhere: skipping them keeps the digest a function of
   // the content, not of leftover empty leaves.
