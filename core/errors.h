@@ -26,6 +26,11 @@ struct SolverError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The caller asked a long stage to stop (its cancel flag was set); nothing was produced.
+struct Cancelled : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 /// "path: message", the form every file-related error takes.
 inline std::string file_message(const std::string& path, const std::string& message) {
   return path + ": " + message;

@@ -422,6 +422,20 @@ std::string split_saliency_feature(const std::string& list, bool& has_saliency) 
   return rest.empty() ? "none" : rest;
 }
 
+namespace {
+/// The path's camera that sees the volume at the finest importance resolution: one geometry serves the path.
+isosurface::FeatureView finest_view(const volume::Volume& volume, const std::vector<CameraSpec>& cameras, double scale) {
+  isosurface::FeatureView best{cameras.front(), scale};
+  double best_size = isosurface::importance_pixel_size(volume, best);
+  for (const CameraSpec& c : cameras) {
+    const isosurface::FeatureView view{c, scale};
+    const double size = isosurface::importance_pixel_size(volume, view);
+    if (size < best_size) best = view, best_size = size;
+  }
+  return best;
+}
+}  // namespace
+
 Json run_path_request(const volume::Volume& volume, const volume::TransferFunction& tf,
                       const volume::RenderOptions& render, const CameraSpec& camera, const PathRenderRequest& request) {
   if (!is_frame_pattern(request.out_pattern))
@@ -431,9 +445,13 @@ Json run_path_request(const volume::Volume& volume, const volume::TransferFuncti
   const std::vector<CameraSpec> cameras = load_camera_path(request.camera_path, camera);
   const Timer setup;
   std::optional<FeatureGeometry> geometry;
-  if (!request.options.features.lines.classes.is_empty())
-    geometry = request.feature_mesh.empty() ? build_feature_geometry(volume, tf, request.geometry)
-                                            : load_feature_geometry(request.feature_mesh);
+  if (!request.options.features.lines.classes.is_empty() && request.feature_mesh.empty()) {
+    FeatureGeometryOptions options = request.geometry;
+    if (!options.view) options.view = finest_view(volume, cameras, request.options.features.lines.importance.scale);
+    geometry = build_feature_geometry(volume, tf, options, request.feature_cache);
+  } else if (!request.options.features.lines.classes.is_empty()) {
+    geometry = load_feature_geometry(request.feature_mesh);
+  }
   const double setup_ms = setup.elapsed_ms();
   const auto frames = render_camera_path(volume, tf, render, cameras, geometry ? &*geometry : nullptr, request.options,
                                          [&](const PathFrame& frame, const ImageRGBA& image) {

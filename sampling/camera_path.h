@@ -122,6 +122,7 @@ struct PathRenderRequest {
   std::string out_pattern;            ///< printf pattern with one integer conversion, e.g. frame_%03d.png
   PathRenderOptions options;
   FeatureGeometryOptions geometry;    ///< used when line classes are enabled
+  isosurface::FeatureCache* feature_cache = nullptr;  ///< optional, not owned
   std::string feature_mesh;           ///< non-empty: load the feature geometry from this mesh instead
 };
 

@@ -8,74 +8,8 @@
 
 #include "core/errors.h"
 #include "core/timer.h"
-#include "mesh/mesh_analysis.h"
-#include "mesh/mesh_io.h"
-#include "mesh/mesh_prep.h"
-#include "volume/iso_values.h"
-#include "volume/marching_cubes.h"
 
 namespace raysift::sampling {
-
-namespace {
-
-// Marching cubes can join sheets at a vertex (two fans) which OpenMesh's decimater cannot represent;
-// dropping the few triangles around such vertices leaves tiny holes that do not change the lines.
-mesh::TriMesh drop_non_manifold_fans(const mesh::TriMesh& surface, std::size_t& dropped) {
-  const std::vector<mesh::VertexKind> kinds = mesh::classify_vertices(surface);
-  mesh::TriMesh out;
-  out.positions = surface.positions;
-  for (const auto& t : surface.triangles) {
-    const bool bad = kinds[t[0]] == mesh::VertexKind::NonManifold || kinds[t[1]] == mesh::VertexKind::NonManifold ||
-                     kinds[t[2]] == mesh::VertexKind::NonManifold;
-    if (bad) {
-      ++dropped;
-    } else {
-      out.triangles.push_back(t);
-    }
-  }
-  return out;
-}
-
-}  // namespace
-
-FeatureGeometry build_feature_geometry(const volume::Volume& volume, const volume::TransferFunction& tf,
-                                       const FeatureGeometryOptions& options) {
-  const Timer timer;
-  FeatureGeometry geometry;
-  geometry.iso_values = options.iso_values;
-  if (geometry.iso_values.empty()) {
-    volume::IsoValueOptions iso_options;
-    iso_options.max_surfaces = options.max_surfaces;
-    for (const volume::IsoValue& v : volume::select_iso_values(volume, tf, iso_options))
-      geometry.iso_values.push_back(v.value);
-  }
-  // Taubin -> decimation -> Taubin per surface (RP paper section 7.2), then one merged mesh.
-  mesh::MeshPrepOptions prep;
-  prep.smooth_before.iterations = prep.smooth_after.iterations = options.smooth_iterations;
-  prep.decimation.ratio = options.decimate_ratio;
-  for (const mesh::TriMesh& raw : volume::extract_isosurfaces(volume, geometry.iso_values)) {
-    if (raw.triangles.empty()) continue;
-    mesh::TriMesh surface;
-    try {
-      surface = mesh::prepare_mesh(drop_non_manifold_fans(raw, geometry.dropped_triangles), prep).mesh;
-    } catch (const InvalidInput&) {
-      // The decimater still refused the surface: keep it smoothed at full size (slower lines, same features).
-      mesh::MeshPrepOptions smooth_only = prep;
-      smooth_only.decimation.ratio = 1.0;
-      surface = mesh::prepare_mesh(raw, smooth_only).mesh;
-      ++geometry.undecimated_surfaces;
-    }
-    const auto base = std::uint32_t(geometry.mesh.positions.size());
-    geometry.mesh.positions.insert(geometry.mesh.positions.end(), surface.positions.begin(), surface.positions.end());
-    for (const auto& t : surface.triangles) geometry.mesh.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
-  }
-  if (geometry.mesh.triangles.empty())
-    throw InvalidInput("the iso-values chosen for the feature lines give no surface; pass iso-values inside the "
-                       "data range");
-  geometry.curvature = mesh::compute_curvature(geometry.mesh);
-  geometry.build_ms = timer.elapsed_ms();
-  return geometry;
-}
 
 features::LineClassSet parse_feature_list(const std::string& list) {
   if (list == "none") return {};
@@ -147,16 +81,6 @@ VolumeFrame render_volume_frame(const volume::RayCaster& caster, const FeatureGe
   return frame;
 }
 
-FeatureGeometry load_feature_geometry(const std::string& mesh_path) {
-  const Timer timer;
-  FeatureGeometry geometry;
-  geometry.mesh = mesh::read_mesh(mesh_path);
-  if (geometry.mesh.triangles.empty()) throw InvalidInput(file_message(mesh_path, "the feature mesh has no triangles"));
-  geometry.curvature = mesh::compute_curvature(geometry.mesh);
-  geometry.build_ms = timer.elapsed_ms();
-  return geometry;
-}
-
 SampledRender render_sampled_volume(const volume::Volume& volume, const volume::TransferFunction& tf,
                                     const volume::RayCaster& caster, const SampledRenderRequest& request) {
   validate(request.sampling);
@@ -164,9 +88,13 @@ SampledRender render_sampled_volume(const volume::Volume& volume, const volume::
     throw InvalidInput("--progressive must be >= 0, got " + std::to_string(request.progressive_frames));
   const bool uses_features = request.sampling.mode == SamplingMode::Prioritized && !request.features.classes.is_empty();
   FeatureGeometry geometry;
-  if (uses_features)
-    geometry = request.feature_mesh.empty() ? build_feature_geometry(volume, tf, request.geometry)
-                                            : load_feature_geometry(request.feature_mesh);
+  if (uses_features && request.feature_mesh.empty()) {
+    FeatureGeometryOptions options = request.geometry;
+    if (!options.view) options.view = isosurface::FeatureView{caster.camera().spec(), request.features.importance.scale};
+    geometry = build_feature_geometry(volume, tf, options, request.feature_cache);
+  } else if (uses_features) {
+    geometry = load_feature_geometry(request.feature_mesh);
+  }
   const FeatureGeometry* geometry_ptr = uses_features ? &geometry : nullptr;
 
   SampledRender out;
@@ -176,25 +104,29 @@ SampledRender render_sampled_volume(const volume::Volume& volume, const volume::
   if (uses_features) {
     stats["feature_triangles"] = geometry.mesh.triangles.size();
     stats["iso_values"] = geometry.iso_values;
+    stats["feature_coarsening"] = geometry.coarsening;
+    stats["feature_cache_hit"] = geometry.from_cache;
   }
-  auto fill = [&](const SampledFrame& f, double importance_ms, double total_ms) {
+  auto fill = [&](const SampledFrame& f, double importance_ms, double total_ms, std::uint64_t samples) {
     stats["rays_traced"] = f.rays_traced;
+    stats["samples"] = samples;
     stats["full_rays"] = f.full_rays;
     stats["level0_rays"] = f.level0_rays;
     stats["ray_fraction"] = f.full_rays ? double(f.rays_traced) / double(f.full_rays) : 0.0;
     stats["times_ms"] = {{"importance", importance_ms}, {"priorities", f.priorities_ms}, {"trace", f.trace_ms},
-                         {"reconstruct", f.reconstruct_ms}, {"total", total_ms},
+                         {"reconstruct", f.reconstruct_ms}, {"total", total_ms}, {"frame", total_ms},
                          {"features_setup", uses_features ? geometry.build_ms : 0.0}};
     if (request.sampling.budget_ms > 0) {
       stats["budget_ms"] = request.sampling.budget_ms;
       stats["budget_too_small"] = f.budget_too_small;
+      stats["overshoot_ms"] = std::max(0.0, total_ms - request.sampling.budget_ms);
     }
     out.budget_too_small = out.budget_too_small || f.budget_too_small;
   };
 
   if (request.progressive_frames == 0) {
     VolumeFrame frame = render_volume_frame(caster, geometry_ptr, request.features, request.sampling);
-    fill(frame.sampled, frame.importance_ms, frame.total_ms);
+    fill(frame.sampled, frame.importance_ms, frame.total_ms, frame.samples);
     out.image = std::move(frame.image);
     return out;
   }
@@ -207,10 +139,11 @@ SampledRender render_sampled_volume(const volume::Volume& volume, const volume::
   SampledFrame frame;
   for (int k = 0; k < request.progressive_frames && !(k > 0 && sampler.converged()); ++k) {
     const Timer timer;
-    frame = sampler.next_frame(caster_trace_batch(caster));
+    std::atomic<std::uint64_t> samples{0};
+    frame = sampler.next_frame(caster_trace_batch(caster, &samples));
     const double ms = timer.elapsed_ms() + (k == 0 ? importance_ms : 0.0);
     frames.push_back({{"rays_traced", frame.rays_traced}, {"total_ms", ms}, {"budget_too_small", frame.budget_too_small}});
-    fill(frame, k == 0 ? importance_ms : 0.0, ms);
+    fill(frame, k == 0 ? importance_ms : 0.0, ms, samples.load());
   }
   stats["progressive"] = frames;
   out.image = composite_frame(frame.image, caster.options().background);

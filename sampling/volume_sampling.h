@@ -12,35 +12,18 @@
 
 #include "features/importance.h"
 #include "features/lines.h"
+#include "isosurface/feature_geometry.h"
 #include "mesh/curvature.h"
-#include "mesh/tri_mesh.h"
 #include "sampling/prioritized.h"
 #include "volume/raycaster.h"
 
 namespace raysift::sampling {
 
-/// View-independent feature geometry of a volume under a transfer function: the iso-surfaces merged
-/// into one mesh, prepared (Taubin, decimation, Taubin; RP paper sections 7.1-7.2), with its curvature.
-/// Built once per TF, reused for every view.
-struct FeatureGeometry {
-  mesh::TriMesh mesh;
-  mesh::MeshCurvature curvature;
-  std::vector<double> iso_values;
-  std::size_t dropped_triangles = 0;  ///< around non-manifold vertices, removed before decimation
-  int undecimated_surfaces = 0;       ///< surfaces the decimater still refused, kept at full size
-  double build_ms = 0;  ///< wall time of extraction + preparation + curvature
-};
-
-struct FeatureGeometryOptions {
-  std::vector<double> iso_values;  ///< empty = chosen from the histogram and the TF
-  int max_surfaces = 3;            ///< cap for the automatic choice (volume/iso_values.h)
-  int smooth_iterations = 10;      ///< Taubin iterations before and after decimation (0 = off)
-  double decimate_ratio = 0.1;     ///< target faces / input faces, in (0,1] (1 = off)
-};
-
-/// \throw InvalidInput if the TF is transparent everywhere (no iso-value), or no surface can be extracted.
-FeatureGeometry build_feature_geometry(const volume::Volume& volume, const volume::TransferFunction& tf,
-                                       const FeatureGeometryOptions& options = {});
+// The feature geometry lives in isosurface/ (the iso-surface pipeline); these names keep sampling's API.
+using isosurface::build_feature_geometry;
+using isosurface::FeatureGeometry;
+using isosurface::FeatureGeometryOptions;
+using isosurface::load_feature_geometry;
 
 /// Which lines drive the importance and how they are rasterised.
 struct FeatureOptions {
@@ -77,16 +60,13 @@ VolumeFrame render_volume_frame(const volume::RayCaster& caster, const FeatureGe
 /// Composites a premultiplied frame over `background` with the caster's shared rule.
 ImageRGBA composite_frame(const ImageRGBA& premultiplied, const Vec3f& background);
 
-/// \brief Feature geometry from a prepared mesh file (e.g. the output of `raysift mesh`) instead of the
-/// volume's iso-surfaces. \throw IoError / InvalidInput naming the file.
-FeatureGeometry load_feature_geometry(const std::string& mesh_path);
-
 /// What `raysift render --mode prioritized|subsample` asks for.
 struct SampledRenderRequest {
   SamplingOptions sampling;
   FeatureOptions features;              ///< classes empty = the control (no feature geometry is built)
   FeatureGeometryOptions geometry;
   std::string feature_mesh;             ///< non-empty: load the feature mesh instead of extracting it
+  isosurface::FeatureCache* feature_cache = nullptr;  ///< optional, not owned
   int progressive_frames = 0;           ///< > 0: that many progressive frames, the last one is returned
 };
 

@@ -1,8 +1,5 @@
-// raysift mesh: iso-surfaces of a volume as one triangle mesh. Flow: parse -> load volume and TF -> choose
-// iso-values (histogram peaks + TF opacity maxima, or --iso) -> marching cubes (one surface per value) ->
-// Taubin -> decimate -> Taubin per surface -> write all surfaces into one mesh file -> stats.
-#include <tbb/parallel_for.h>
-
+// raysift mesh: iso-surfaces of a volume as one triangle mesh. Flow: parse -> load volume and TF -> the
+// library's iso-surface pipeline (isosurface/pipeline.h) -> write all surfaces into one mesh file -> stats.
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -16,9 +13,8 @@
 #include "core/timer.h"
 #include "mesh/mesh_analysis.h"
 #include "mesh/mesh_io.h"
-#include "mesh/mesh_prep.h"
-#include "volume/iso_values.h"
-#include "volume/marching_cubes.h"
+#include "core/progress.h"
+#include "isosurface/pipeline.h"
 #include "volume/transfer_function.h"
 
 namespace raysift::app {
@@ -91,125 +87,94 @@ std::string echo_command(const MeshCliOptions& o, const std::vector<double>& iso
   return s.str();
 }
 
+/// --iso values, each checked against the grid's data range.
+std::vector<double> given_iso_values(const MeshCliOptions& o, const volume::GridInfo& info) {
+  std::vector<double> values;
+  if (o.iso.empty()) return values;
+  for (const double v : parse_iso_list(o.iso)) {
+    if (v < info.value_min || v > info.value_max) {
+      std::ostringstream range;
+      range << "within the data range [" << info.value_min << ", " << info.value_max << "] of grid '" << info.name << "'";
+      bad_flag("--iso", range.str(), std::to_string(v));
+    }
+    values.push_back(v);
+  }
+  return values;
+}
+
+isosurface::PipelineOptions pipeline_options(const MeshCliOptions& o) {
+  isosurface::PipelineOptions p;
+  p.iso_choice.max_surfaces = o.max_surfaces;
+  p.marching_cubes.flip_orientation = o.flip;
+  for (mesh::SmoothingOptions* s : {&p.prep.smooth_before, &p.prep.smooth_after}) {
+    s->iterations = o.smooth;
+    s->lambda = o.lambda;
+    s->mu = o.mu;
+    s->weights = o.cotangent ? mesh::SmoothingWeights::Cotangent : mesh::SmoothingWeights::Uniform;
+  }
+  p.prep.decimation.ratio = o.decimate;
+  p.prep.decimation.max_error = o.max_error;
+  p.total_target_faces = std::size_t(o.faces);
+  return p;
+}
+
+Json surface_json(const mesh::TriMesh& m) {
+  if (m.empty()) return {{"triangles", 0}, {"vertices", 0}, {"watertight", false}, {"euler_characteristic", 0}, {"area", 0.0}};
+  const mesh::MeshAnalysis a = mesh::analyze_mesh(m);
+  Json s = {{"triangles", a.faces},
+            {"vertices", a.vertices},
+            {"watertight", a.is_watertight()},
+            {"euler_characteristic", a.euler_characteristic},
+            {"area", a.area}};
+  if (a.is_watertight()) s["enclosed_volume"] = a.signed_volume;
+  return s;
+}
+
+Json stages_json(const isosurface::StageTimes& t) {
+  return {{"marching_cubes", stage_json(t.marching_cubes)},
+          {"smooth_before", stage_json(t.smooth_before)},
+          {"decimate", stage_json(t.decimate)},
+          {"smooth_after", stage_json(t.smooth_after)}};
+}
+
 void run(const MeshCliOptions& o, const CommonOptions& common, CLI::App& sub) {
   validate(o, sub);
   VolumeInput input = load_volume_input(o.volume, o.grid, o.tf, o.tf_normalized, common.scene_path, "mesh");
-  const volume::Volume& vol = input.volume;
-  const volume::GridInfo& info = input.info;
-  const std::unique_ptr<volume::TransferFunction>& tf = input.tf;
-  const std::string& tf_source = input.tf_source;
-  if (!tf && o.iso.empty())
+  if (!input.tf && o.iso.empty())
     throw UsageError("mesh needs --tf TF.json (or a --scene with a 'transfer_function') or --iso; see --help");
+  isosurface::PipelineOptions options = pipeline_options(o);
+  options.iso_values = given_iso_values(o, input.info);
+  ProgressBar bar("mesh", !common.quiet);
+  options.progress = [&bar](double f) { bar.update(f); };
 
-  std::vector<volume::IsoValue> isos;
-  if (tf) {
-    volume::IsoValueOptions iso_options;
-    iso_options.max_surfaces = o.max_surfaces;
-    try {
-      isos = volume::select_iso_values(vol, *tf, iso_options);
-    } catch (const InvalidInput& e) {
-      throw InvalidInput(file_message(tf_source, std::string(e.what()) + "; nothing written"));
-    }
+  isosurface::IsosurfaceSet set;
+  try {
+    set = isosurface::build_isosurfaces(input.volume, o.iso.empty() ? input.tf.get() : nullptr, options);
+  } catch (const InvalidInput& e) {
+    if (!o.iso.empty()) throw;
+    throw InvalidInput(file_message(input.tf_source, std::string(e.what()) + "; nothing written"));
   }
-  if (!o.iso.empty()) {
-    isos.clear();
-    for (const double v : parse_iso_list(o.iso)) {
-      if (v < info.value_min || v > info.value_max) {
-        std::ostringstream range;
-        range << "within the data range [" << info.value_min << ", " << info.value_max << "] of grid '" << info.name << "'";
-        bad_flag("--iso", range.str(), std::to_string(v));
-      }
-      isos.push_back({v, "given with --iso"});
-    }
-  }
-  if (!common.quiet)
-    for (const auto& iso : isos) std::cout << "iso-value " << iso.value << ": " << iso.reason << "\n";
-
   std::vector<double> iso_values;
-  for (const auto& iso : isos) iso_values.push_back(iso.value);
-  if (common.verbose) std::cerr << echo_command(o, iso_values, common) << "\n";
-  volume::MarchingCubesOptions mc_options;
-  mc_options.flip_orientation = o.flip;
-  Timer mc_timer;
-  const std::vector<mesh::TriMesh> surfaces = volume::extract_isosurfaces(vol, iso_values, mc_options);
-  const double mc_ms = mc_timer.elapsed_ms();
-  std::size_t mc_triangles = 0;
-  for (const auto& s : surfaces) mc_triangles += s.triangle_count();
-
-  mesh::MeshPrepOptions prep;
-  prep.smooth_before.iterations = prep.smooth_after.iterations = o.smooth;
-  prep.smooth_before.lambda = prep.smooth_after.lambda = o.lambda;
-  prep.smooth_before.mu = prep.smooth_after.mu = o.mu;
-  prep.smooth_before.weights = prep.smooth_after.weights =
-      o.cotangent ? mesh::SmoothingWeights::Cotangent : mesh::SmoothingWeights::Uniform;
-  prep.decimation.ratio = o.decimate;
-  prep.decimation.max_error = o.max_error;
-
-  mesh::TriMesh combined;
-  mesh::StageReport smooth_before, decimate, smooth_after;
   Json surface_stats = Json::array();
-  // Surfaces are prepared concurrently (OpenMesh's decimater is serial per mesh); each result lands in its
-  // own slot and everything below walks them in iso order, so the output does not depend on scheduling.
-  std::vector<mesh::MeshPrepResult> prepared(surfaces.size());
-  tbb::parallel_for(std::size_t(0), surfaces.size(), [&](std::size_t i) {
-    if (surfaces[i].empty()) return;
-    mesh::MeshPrepOptions surface_prep = prep;
-    if (o.faces > 0)  // --faces is a total; each surface gets its share of the marching-cubes triangles
-      surface_prep.decimation.target_faces = std::min<std::size_t>(
-          surfaces[i].triangle_count(),
-          std::max<std::size_t>(4, std::size_t(std::llround(double(o.faces) * double(surfaces[i].triangle_count()) /
-                                                             double(mc_triangles)))));
-    prepared[i] = mesh::prepare_mesh(surfaces[i], surface_prep);
-  });
-  for (std::size_t i = 0; i < surfaces.size(); ++i) {
-    if (surfaces[i].empty()) {
-      if (!common.quiet) std::cerr << "raysift: warning: iso-value " << iso_values[i] << " gives an empty surface\n";
-      surface_stats.push_back({{"triangles", 0}, {"vertices", 0}, {"watertight", false}, {"euler_characteristic", 0}, {"area", 0.0}});
-      continue;
-    }
-    const mesh::MeshPrepResult& r = prepared[i];
-    smooth_before.ms += r.smooth_before.ms;
-    smooth_before.triangles += r.smooth_before.triangles;
-    decimate.ms += r.decimate.ms;
-    decimate.triangles += r.decimate.triangles;
-    smooth_after.ms += r.smooth_after.ms;
-    smooth_after.triangles += r.smooth_after.triangles;
-    if (!r.decimation_reached_target && !common.quiet)
-      std::cerr << "raysift: warning: surface " << iso_values[i] << ": --max-error stopped decimation at "
-                << r.mesh.triangle_count() << " triangles\n";
-
-    const mesh::MeshAnalysis a = mesh::analyze_mesh(r.mesh);
-    Json s = {{"triangles", a.faces},
-              {"vertices", a.vertices},
-              {"watertight", a.is_watertight()},
-              {"euler_characteristic", a.euler_characteristic},
-              {"area", a.area}};
-    if (a.is_watertight()) s["enclosed_volume"] = a.signed_volume;
-    surface_stats.push_back(s);
-
-    const auto offset = std::uint32_t(combined.positions.size());
-    combined.positions.insert(combined.positions.end(), r.mesh.positions.begin(), r.mesh.positions.end());
-    for (const auto& t : r.mesh.triangles) combined.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  for (const isosurface::Surface& s : set.surfaces) {
+    iso_values.push_back(s.iso.value);
+    if (!common.quiet) std::cout << "iso-value " << s.iso.value << ": " << s.iso.reason << "\n";
+    if (s.mesh.empty() && !common.quiet)
+      std::cerr << "raysift: warning: iso-value " << s.iso.value << " gives an empty surface\n";
+    if (!s.decimation_reached_target && !common.quiet)
+      std::cerr << "raysift: warning: surface " << s.iso.value << ": --max-error stopped decimation at "
+                << s.mesh.triangle_count() << " triangles\n";
+    surface_stats.push_back(surface_json(s.mesh));
   }
+  if (common.verbose) std::cerr << echo_command(o, iso_values, common) << "\n";
+  const mesh::TriMesh combined = isosurface::merge_surfaces(set);
   if (combined.empty())
     throw InvalidInput(file_message(input.volume_path, "no iso-surface found at the chosen iso-values; nothing written"));
   mesh::write_mesh(o.out, combined);
-
-  if (common.verbose)
-    std::cerr << "marching cubes " << mc_ms << " ms (" << mc_triangles << " triangles), smooth " << smooth_before.ms
-              << " ms, decimate " << decimate.ms << " ms (" << decimate.triangles << " triangles), smooth "
-              << smooth_after.ms << " ms\n";
   if (!common.quiet)
-    std::cout << "wrote " << o.out << ": " << surfaces.size() << " surface(s), " << combined.triangle_count()
+    std::cout << "wrote " << o.out << ": " << set.surfaces.size() << " surface(s), " << combined.triangle_count()
               << " triangles\n";
-  const Json stats = {{"iso_values", iso_values},
-                      {"surfaces", surface_stats},
-                      {"stages",
-                       {{"marching_cubes", stage_json({mc_ms, mc_triangles})},
-                        {"smooth_before", stage_json(smooth_before)},
-                        {"decimate", stage_json(decimate)},
-                        {"smooth_after", stage_json(smooth_after)}}}};
-  write_stats_if_requested(common, stats);
+  write_stats_if_requested(common, {{"iso_values", iso_values}, {"surfaces", surface_stats}, {"stages", stages_json(set.stages)}});
 }
 
 RegisterCommand reg(

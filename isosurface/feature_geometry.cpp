@@ -1,0 +1,132 @@
+#include "isosurface/feature_geometry.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "core/errors.h"
+#include "core/timer.h"
+#include "mesh/mesh_io.h"
+#include "volume/resample.h"
+
+namespace raysift::isosurface {
+
+namespace {
+
+constexpr int kMinCoarseCells = 32;
+
+/// Distance from the eye to the nearest point of the world box (0 inside it).
+double distance_to_box(const Vec3d& p, const Vec3d& lo, const Vec3d& hi) {
+  const double dx = std::max({lo.x - p.x, 0.0, p.x - hi.x}), dy = std::max({lo.y - p.y, 0.0, p.y - hi.y}),
+               dz = std::max({lo.z - p.z, 0.0, p.z - hi.z});
+  return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+double max_voxel_size(const volume::Volume& v) {
+  const Vec3d s = v.voxel_size();
+  return std::max({s.x, s.y, s.z});
+}
+
+/// World-space simplification bound for the view, rounded down to a power of two so that nearby cameras
+/// share one cache entry (rounding down keeps the bound conservative).
+double simplification_error(const volume::Volume& volume, const FeatureGeometryOptions& o) {
+  if (!o.view || !(o.max_error_px > 0)) return 0.0;
+  const double e = o.max_error_px * importance_pixel_size(volume, *o.view);
+  return e > 0 ? std::exp2(std::floor(std::log2(e))) : 0.0;
+}
+
+std::string options_fingerprint(const FeatureGeometryOptions& o, int coarsening, double max_error) {
+  std::ostringstream s;
+  s.precision(17);
+  s << "feature-geometry v1;iso=";
+  for (const double v : o.iso_values) s << v << ',';
+  s << ";max_surfaces=" << o.max_surfaces << ";smooth=" << o.smooth_iterations << ";ratio=" << o.decimate_ratio
+    << ";coarsening=" << coarsening << ";max_error=" << max_error;
+  return s.str();
+}
+
+PipelineOptions pipeline_options(const FeatureGeometryOptions& o, double max_error) {
+  PipelineOptions p;
+  p.iso_values = o.iso_values;
+  p.iso_choice.max_surfaces = o.max_surfaces;
+  p.prep.smooth_before.iterations = p.prep.smooth_after.iterations = o.smooth_iterations;
+  p.prep.decimation.ratio = o.decimate_ratio;
+  p.prep.decimation.max_error = max_error;
+  p.cancel = o.cancel;
+  p.progress = o.progress;
+  return p;
+}
+
+}  // namespace
+
+double importance_pixel_size(const volume::Volume& volume, const FeatureView& view) {
+  const Camera camera(view.camera);  // validates the spec
+  if (!(view.importance_scale > 0 && view.importance_scale <= 1))
+    throw InvalidInput("importance scale must be in (0, 1], got " + std::to_string(view.importance_scale));
+  const volume::GridInfo info = volume.info();
+  const double distance = distance_to_box(view.camera.eye, info.bbox_min, info.bbox_max);
+  const double buffer_height = std::max(1.0, std::round(view.camera.height * view.importance_scale));
+  return 2.0 * distance * std::tan(0.5 * view.camera.fov_y_deg * M_PI / 180.0) / buffer_height;
+}
+
+int choose_coarsening(const volume::Volume& volume, const FeatureGeometryOptions& options) {
+  if (options.coarsening != 0) return options.coarsening;
+  if (!options.view || volume.is_empty()) return 1;
+  const double cell_limit = options.cell_px * importance_pixel_size(volume, *options.view);
+  const volume::GridInfo info = volume.info();
+  const int extent = 1 + std::max({info.index_max.x - info.index_min.x, info.index_max.y - info.index_min.y,
+                                   info.index_max.z - info.index_min.z});
+  int factor = 1;
+  while (factor < 8 && 2 * factor * max_voxel_size(volume) <= cell_limit && extent / (2 * factor) >= kMinCoarseCells)
+    factor *= 2;
+  return factor;
+}
+
+FeatureGeometry build_feature_geometry(const volume::Volume& volume, const volume::TransferFunction& tf,
+                                       const FeatureGeometryOptions& options, FeatureCache* cache) {
+  const Timer timer;
+  FeatureGeometry geometry;
+  geometry.coarsening = choose_coarsening(volume, options);
+  const double max_error = simplification_error(volume, options);
+  std::optional<CacheKey> key;
+  if (cache) {
+    key = feature_cache_key(volume, tf, options_fingerprint(options, geometry.coarsening, max_error));
+    if (std::optional<CachedGeometry> hit = cache->find(*key)) {
+      geometry.mesh = std::move(hit->mesh);
+      geometry.iso_values = std::move(hit->iso_values);
+      geometry.from_cache = true;
+    }
+  }
+  if (!geometry.from_cache) {
+    const volume::Volume level = volume::downsample(volume, geometry.coarsening);
+    FeatureGeometryOptions chosen = options;
+    if (chosen.iso_values.empty()) {  // chosen on the full-resolution histogram, so every level agrees
+      volume::IsoValueOptions iso_options;
+      iso_options.max_surfaces = options.max_surfaces;
+      for (const volume::IsoValue& v : volume::select_iso_values(volume, tf, iso_options))
+        chosen.iso_values.push_back(v.value);
+    }
+    const IsosurfaceSet set = build_isosurfaces(level, &tf, pipeline_options(chosen, max_error));
+    geometry.mesh = merge_surfaces(set);
+    geometry.iso_values = chosen.iso_values;
+    if (geometry.mesh.triangles.empty())
+      throw InvalidInput("the iso-values chosen for the feature lines give no surface; pass iso-values inside the "
+                         "data range");
+    if (cache) cache->store(*key, {geometry.iso_values, geometry.mesh});
+  }
+  geometry.curvature = mesh::compute_curvature(geometry.mesh);
+  geometry.build_ms = timer.elapsed_ms();
+  return geometry;
+}
+
+FeatureGeometry load_feature_geometry(const std::string& mesh_path) {
+  const Timer timer;
+  FeatureGeometry geometry;
+  geometry.mesh = mesh::read_mesh(mesh_path);
+  if (geometry.mesh.triangles.empty()) throw InvalidInput(file_message(mesh_path, "the feature mesh has no triangles"));
+  geometry.curvature = mesh::compute_curvature(geometry.mesh);
+  geometry.build_ms = timer.elapsed_ms();
+  return geometry;
+}
+
+}  // namespace raysift::isosurface

@@ -1,0 +1,70 @@
+#pragma once
+/// \file View-independent feature geometry of a volume under a transfer function: the iso-surfaces merged
+/// into one mesh, prepared (Taubin, simplification, Taubin; RP paper §7.1-7.2), with its curvature. Key
+/// decision: the importance buffer the lines feed is a few hundred pixels across, so the geometry is built
+/// only as fine as that buffer resolves: marching cubes runs on a coarser level of the grid whose cells
+/// project to about one importance pixel, and simplification stops at a fraction of a pixel of error.
+/// Built once per (volume, TF, options) and reused for every view; optionally cached (feature_cache.h).
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/camera.h"
+#include "isosurface/feature_cache.h"
+#include "isosurface/pipeline.h"
+#include "mesh/curvature.h"
+#include "mesh/tri_mesh.h"
+#include "volume/transfer_function.h"
+#include "volume/volume.h"
+
+namespace raysift::isosurface {
+
+struct FeatureGeometry {
+  mesh::TriMesh mesh;
+  mesh::MeshCurvature curvature;
+  std::vector<double> iso_values;  ///< the surfaces in `mesh`
+  int coarsening = 1;              ///< grid level used: cells of this many voxels per axis
+  bool from_cache = false;
+  double build_ms = 0;             ///< wall time of the whole set-up (cache look-up included)
+};
+
+/// The view the geometry is made for: the frame camera and the importance buffer's size relative to it.
+struct FeatureView {
+  CameraSpec camera;
+  double importance_scale = 0.5;  ///< importance buffer side / frame side, in (0, 1]
+};
+
+struct FeatureGeometryOptions {
+  std::vector<double> iso_values;  ///< empty = chosen from the histogram and the TF
+  int max_surfaces = 3;            ///< cap for the automatic choice (volume/iso_values.h)
+  int smooth_iterations = 10;      ///< Taubin iterations before and after simplification (0 = off)
+  double decimate_ratio = 0.1;     ///< target faces / input faces, in (0,1] (1 = off)
+  /// Grid level: 0 = chosen from `view` (1 without a view); else 1, 2, 4 or 8 voxels per cell.
+  int coarsening = 0;
+  double cell_px = 1.0;            ///< automatic level: the coarsest whose cells project to <= this many importance px
+  /// > 0 and a view: simplification also stops once its error would exceed this many importance pixels.
+  double max_error_px = 0.5;
+  std::optional<FeatureView> view;
+  const std::atomic<bool>* cancel = nullptr;  ///< see PipelineOptions::cancel
+  std::function<void(double)> progress;       ///< see PipelineOptions::progress
+};
+
+/// Size of one importance-buffer pixel in world units at the point of the volume's bounding box nearest to
+/// the eye (the finest the view resolves anywhere in the volume).
+double importance_pixel_size(const volume::Volume& volume, const FeatureView& view);
+
+/// The coarsening the options choose for `volume` (1, 2, 4 or 8): monotone, a larger view never gets a
+/// coarser level. The coarse grid keeps at least 32 cells along its longest active extent.
+int choose_coarsening(const volume::Volume& volume, const FeatureGeometryOptions& options);
+
+/// \brief Builds (or finds in `cache`, when given) the feature geometry.
+/// \throw InvalidInput if the TF is transparent everywhere (no iso-value), or no surface can be extracted;
+///        Cancelled when the cancel flag is set.
+FeatureGeometry build_feature_geometry(const volume::Volume& volume, const volume::TransferFunction& tf,
+                                       const FeatureGeometryOptions& options = {}, FeatureCache* cache = nullptr);
+
+/// \brief Feature geometry from a prepared mesh file (e.g. the output of `raysift mesh`) instead of the
+/// volume's iso-surfaces. \throw IoError / InvalidInput naming the file.
+FeatureGeometry load_feature_geometry(const std::string& mesh_path);
+
+}  // namespace raysift::isosurface
