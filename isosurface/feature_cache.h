@@ -52,6 +52,13 @@ class FeatureCache {
   const std::string& directory() const { return directory_; }
 
  private:
+  bool uses_disk() const { return !directory_.empty() && disk_ok_; }
+  std::string entry_path(const CacheKey& key) const;
+  /// nullopt for a missing entry (silently) or an invalid one (with a warning).
+  std::optional<CachedGeometry> read_entry(const CacheKey& key);
+  /// Switches to memory only, warning once with the directory and the reason.
+  void disable_disk(const std::string& reason);
+
   std::string directory_;
   std::function<void(const std::string&)> warn_;
   bool disk_ok_ = true;
