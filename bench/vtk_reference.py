@@ -6,7 +6,8 @@ Run with Debian's interpreter (/usr/bin/python3, package python3-vtk9). Each mod
 
   vtk_reference.py flying-edges RAW[.gz] NX NY NZ u8|f32 ISO RUNS
   vtk_reference.py windowed-sinc MESH.ply ITERATIONS RUNS
-  vtk_reference.py quadric-decimation MESH.ply TARGET_TRIANGLES RUNS
+  vtk_reference.py quadric-decimation MESH.ply TARGET_TRIANGLES RUNS [OUT.ply]
+    (OUT.ply: the decimated mesh as binary PLY, so the C++ bench measures its distances with its own code)
 """
 import gzip
 import os
@@ -82,13 +83,19 @@ def windowed_sinc(path, iterations, runs):
           f"vertex_iterations_per_s={vertices * iterations / (ms * 1e-3):.4g}")
 
 
-def quadric_decimation(path, target, runs):
+def quadric_decimation(path, target, runs, out_path=None):
     reader = read_ply(path)
     faces = reader.GetOutput().GetNumberOfCells()
     decimate = vtk.vtkQuadricDecimation()
     decimate.SetInputConnection(reader.GetOutputPort())
     decimate.SetTargetReduction(1.0 - target / faces)
     ms = timed(decimate, runs)
+    if out_path:
+        writer = vtk.vtkPLYWriter()
+        writer.SetInputConnection(decimate.GetOutputPort())
+        writer.SetFileTypeToBinary()
+        writer.SetFileName(out_path)
+        writer.Write()
     print(f"ms={ms:.3f} triangles={decimate.GetOutput().GetNumberOfCells()} input_triangles={faces}")
 
 
@@ -98,8 +105,8 @@ def main(argv):
         flying_edges(argv[2], int(argv[3]), int(argv[4]), int(argv[5]), argv[6], float(argv[7]), int(argv[8]))
     elif mode == "windowed-sinc" and len(argv) == 5:
         windowed_sinc(argv[2], int(argv[3]), int(argv[4]))
-    elif mode == "quadric-decimation" and len(argv) == 5:
-        quadric_decimation(argv[2], int(argv[3]), int(argv[4]))
+    elif mode == "quadric-decimation" and len(argv) in (5, 6):
+        quadric_decimation(argv[2], int(argv[3]), int(argv[4]), argv[5] if len(argv) == 6 else None)
     else:
         sys.exit(__doc__)
 

@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 
 packages=(cmake g++ make pkg-config ccache zlib1g-dev
   libopenvdb-dev libboost-iostreams-dev libopenvdb-tools
-  libopenmesh-dev libembree-dev
+  libopenmesh-dev libmeshoptimizer-dev libembree-dev
   libopenimageio-dev libopencv-core-dev openimageio-tools
   libtbb-dev libgtest-dev libbenchmark-dev
   nlohmann-json3-dev libcli11-dev)
