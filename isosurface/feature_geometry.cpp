@@ -73,6 +73,28 @@ void split_hidden(const volume::Volume& volume, const volume::Volume& level, int
   isos = std::move(kept);
 }
 
+std::string box_text(const Vec3d& lo, const Vec3d& hi) {
+  std::ostringstream s;
+  s << "[" << lo.x << ", " << lo.y << ", " << lo.z << "] - [" << hi.x << ", " << hi.y << ", " << hi.z << "]";
+  return s.str();
+}
+
+void check_bounds(const mesh::TriMesh& m, const volume::Volume& volume, const std::string& path) {
+  Vec3d lo(m.positions.front()), hi(m.positions.front());
+  for (const Vec3f& p : m.positions) {
+    lo = {std::min(lo.x, double(p.x)), std::min(lo.y, double(p.y)), std::min(lo.z, double(p.z))};
+    hi = {std::max(hi.x, double(p.x)), std::max(hi.y, double(p.y)), std::max(hi.z, double(p.z))};
+  }
+  const volume::GridInfo info = volume.info();
+  const Vec3d grow = volume.voxel_size();
+  const Vec3d vlo = info.bbox_min - grow, vhi = info.bbox_max + grow;
+  const bool inside = volume.is_empty() || (lo.x >= vlo.x && lo.y >= vlo.y && lo.z >= vlo.z && hi.x <= vhi.x &&
+                                            hi.y <= vhi.y && hi.z <= vhi.z);
+  if (!inside)
+    throw InvalidInput(file_message(path, "the feature mesh's bounding box " + box_text(lo, hi) +
+                                              " does not fit the volume's " + box_text(info.bbox_min, info.bbox_max)));
+}
+
 }  // namespace
 
 double importance_pixel_size(const volume::Volume& volume, const FeatureView& view) {
@@ -136,11 +158,12 @@ FeatureGeometry build_feature_geometry(const volume::Volume& volume, const volum
   return geometry;
 }
 
-FeatureGeometry load_feature_geometry(const std::string& mesh_path) {
+FeatureGeometry load_feature_geometry(const std::string& mesh_path, const volume::Volume* volume) {
   const Timer timer;
   FeatureGeometry geometry;
   geometry.mesh = mesh::read_mesh(mesh_path);
   if (geometry.mesh.triangles.empty()) throw InvalidInput(file_message(mesh_path, "the feature mesh has no triangles"));
+  if (volume) check_bounds(geometry.mesh, *volume, mesh_path);
   geometry.curvature = mesh::compute_curvature(geometry.mesh);
   geometry.build_ms = timer.elapsed_ms();
   return geometry;

@@ -68,7 +68,9 @@ FeatureGeometry build_feature_geometry(const volume::Volume& volume, const volum
                                        const FeatureGeometryOptions& options = {}, FeatureCache* cache = nullptr);
 
 /// \brief Feature geometry from a prepared mesh file (e.g. the output of `raysift mesh`) instead of the
-/// volume's iso-surfaces. \throw IoError / InvalidInput naming the file.
-FeatureGeometry load_feature_geometry(const std::string& mesh_path);
+/// volume's iso-surfaces. With `volume`, the mesh's bounding box must lie within the volume's world bounding
+/// box grown by one voxel (iso-surfaces of that volume always do).
+/// \throw IoError / InvalidInput naming the file (and both boxes when they do not match).
+FeatureGeometry load_feature_geometry(const std::string& mesh_path, const volume::Volume* volume = nullptr);
 
 }  // namespace raysift::isosurface

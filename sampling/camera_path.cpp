@@ -450,7 +450,7 @@ Json run_path_request(const volume::Volume& volume, const volume::TransferFuncti
     if (!options.view) options.view = finest_view(volume, cameras, request.options.features.lines.importance.scale);
     geometry = build_feature_geometry(volume, tf, options, request.feature_cache);
   } else if (!request.options.features.lines.classes.is_empty()) {
-    geometry = load_feature_geometry(request.feature_mesh);
+    geometry = load_feature_geometry(request.feature_mesh, &volume);
   }
   const double setup_ms = setup.elapsed_ms();
   const auto frames = render_camera_path(volume, tf, render, cameras, geometry ? &*geometry : nullptr, request.options,

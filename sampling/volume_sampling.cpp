@@ -93,7 +93,7 @@ SampledRender render_sampled_volume(const volume::Volume& volume, const volume::
     if (!options.view) options.view = isosurface::FeatureView{caster.camera().spec(), request.features.importance.scale};
     geometry = build_feature_geometry(volume, tf, options, request.feature_cache);
   } else if (uses_features) {
-    geometry = load_feature_geometry(request.feature_mesh);
+    geometry = load_feature_geometry(request.feature_mesh, &volume);
   }
   const FeatureGeometry* geometry_ptr = uses_features ? &geometry : nullptr;
 

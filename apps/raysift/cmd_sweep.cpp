@@ -9,6 +9,7 @@
 #include "apps/raysift/command.h"
 #include "core/file_util.h"
 #include "core/scene.h"
+#include "isosurface/feature_geometry.h"
 #include "sampling/trade.h"
 #include "volume/vdb_io.h"
 
@@ -90,6 +91,13 @@ void write_plot(const std::string& csv_path, const std::string& png_path, const 
                                          "python3-matplotlib); the CSV was written"));
 }
 
+/// The feature geometry fitted to the sweep's view and importance resolution.
+isosurface::FeatureGeometryOptions feature_options(const CameraSpec& camera, const sampling::TradeOptions& trade) {
+  isosurface::FeatureGeometryOptions o;
+  o.view = isosurface::FeatureView{camera, trade.features.importance.scale};
+  return o;
+}
+
 RegisterCommand reg(
     "sweep", "speed/accuracy trade: full render, then prioritized, control and subsample at each ray fraction",
     [](CLI::App& sub, CommonOptions& common) -> RunFunction {
@@ -141,8 +149,8 @@ RegisterCommand reg(
 
         sampling::FeatureGeometry geometry;
         if (!trade.features.classes.is_empty())
-          geometry = opt->feature_mesh.empty() ? sampling::build_feature_geometry(vol, tf)
-                                               : sampling::load_feature_geometry(opt->feature_mesh);
+          geometry = opt->feature_mesh.empty() ? isosurface::build_feature_geometry(vol, tf, feature_options(camera, trade))
+                                               : isosurface::load_feature_geometry(opt->feature_mesh, &vol);
         const sampling::TradeResult result =
             sampling::run_trade(caster, trade.features.classes.is_empty() ? nullptr : &geometry, trade);
         const std::string csv = sampling::trade_csv(result.rows);

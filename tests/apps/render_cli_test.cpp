@@ -134,3 +134,54 @@ TEST(RenderCli, TfOutsideDataRangeWarnsAndRendersBackground) {
 
 }  // namespace
 }  // namespace raysift
+
+namespace raysift {
+namespace {
+
+TEST(RenderCli, FrameTimeAndSamplesInEveryMode) {
+  const std::string dir = make_ball_dir("render_frame_time");
+  for (const char* mode : {"full", "prioritized", "subsample"}) {
+    const CliRun r = raysift(dir, std::string("render ball.vdb --tf tf.json --width 40 --height 30 --ray-fraction 0.5 "
+                                              "--mode ") + mode + " -o out.exr --stats s.json");
+    ASSERT_EQ(r.code, 0) << mode << ": " << r.err;
+    const Json s = read_json_file(dir + "/s.json");
+    EXPECT_GT(s["times_ms"]["frame"].get<double>(), 0.0) << mode;
+    EXPECT_LE(s["times_ms"]["frame"].get<double>(), s["times_ms"]["total"].get<double>() + 1e-9) << mode;
+    EXPECT_GT(s["samples"].get<double>(), 0.0) << mode;
+  }
+}
+
+TEST(RenderCli, FeatureCacheIsReusedAndAnUnwritableOneOnlyWarns) {
+  const std::string dir = make_ball_dir("render_feature_cache");
+  const std::string args = "render ball.vdb --tf tf.json --width 40 --height 30 --mode prioritized --ray-fraction 0.5 ";
+  const CliRun first = raysift(dir, args + "--feature-cache fc -o a.exr --stats a.json");
+  ASSERT_EQ(first.code, 0) << first.err;
+  EXPECT_FALSE(read_json_file(dir + "/a.json")["feature_cache_hit"].get<bool>());
+  const CliRun second = raysift(dir, args + "--feature-cache fc -o b.exr --stats b.json");
+  ASSERT_EQ(second.code, 0) << second.err;
+  EXPECT_TRUE(read_json_file(dir + "/b.json")["feature_cache_hit"].get<bool>());
+  EXPECT_EQ(read_image_rgba(dir + "/a.exr").pixels, read_image_rgba(dir + "/b.exr").pixels);
+
+  std::ofstream(dir + "/plain_file") << "not a directory";
+  const CliRun blocked = raysift(dir, args + "--feature-cache plain_file/fc -o c.exr");
+  EXPECT_EQ(blocked.code, 0) << blocked.err;
+  EXPECT_NE(blocked.err.find("warning"), std::string::npos) << blocked.err;
+  EXPECT_EQ(read_image_rgba(dir + "/c.exr").pixels, read_image_rgba(dir + "/a.exr").pixels);
+}
+
+TEST(RenderCli, FeatureMeshOutsideTheVolumeNamesBothBoxes) {
+  const std::string dir = make_ball_dir("render_feature_mesh_bounds");
+  const CliRun far = raysift(dir, "make-volume ball --dims 32,32,32 --radius 12 --voxel-size 10 --quiet -o far.vdb");
+  ASSERT_EQ(far.code, 0) << far.err;
+  const CliRun mesh = raysift(dir, "mesh far.vdb --iso 0.5 --smooth 0 --decimate 1 --quiet -o far.ply");
+  ASSERT_EQ(mesh.code, 0) << mesh.err;
+  const CliRun r = raysift(dir, "render ball.vdb --tf tf.json --width 20 --height 20 --mode prioritized "
+                                "--feature-mesh far.ply -o out.exr");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("far.ply"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("does not fit the volume's"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/out.exr"));
+}
+
+}  // namespace
+}  // namespace raysift
