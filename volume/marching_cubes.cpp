@@ -40,6 +40,9 @@ constexpr int kChunk = 64;                  // blocks per parallel task (cancel 
 
 // Leaf offset = x << 6 | y << 3 | z, so mask word x holds the plane x, byte y of it the row (x, y).
 constexpr int edge_id(int x, int y, int z, int axis) { return ((x * kB + y) * kB + z) * 3 + axis; }
+/// Edge numbering of the whole corner region (coordinates 0..8), for the per-block vertex-index table.
+constexpr int region_edge(int x, int y, int z, int axis) { return ((x * kR + y) * kR + z) * 3 + axis; }
+constexpr int kRegionEdges = kR * kR * kR * 3;
 
 /// Bit count without relying on the POPCNT instruction (the build targets baseline x86-64).
 inline int popcount64(std::uint64_t x) {
@@ -67,6 +70,28 @@ constexpr std::array<std::uint32_t, 256> make_spread3() {
   return table;
 }
 constexpr std::array<std::uint32_t, 256> kSpread3 = make_spread3();
+
+/// The triangles of each case as region_edge() offsets from the cell's region_edge(x, y, z, 0).
+struct CaseCorners {
+  std::uint8_t corner_count = 0;  ///< 3 per triangle
+  std::array<std::int16_t, 3 * detail::kMcMaxTriangles> offset{};
+};
+
+const std::array<CaseCorners, 256>& case_corners() {
+  static const std::array<CaseCorners, 256> table = [] {
+    std::array<CaseCorners, 256> t;
+    for (int c = 0; c < 256; ++c) {
+      const detail::McCase& mc = detail::marching_cubes_cases()[c];
+      t[c].corner_count = std::uint8_t(3 * mc.triangle_count);
+      for (int k = 0; k < t[c].corner_count; ++k) {
+        const int e = mc.edges[k], start = detail::kEdgeStart[e];
+        t[c].offset[k] = std::int16_t(region_edge(start & 1, (start >> 1) & 1, (start >> 2) & 1, detail::edge_axis(e)));
+      }
+    }
+    return t;
+  }();
+  return table;
+}
 
 /// Orders block origins by (z, y, x); origins are multiples of 8, so 21 bits per axis cover ±2^23 voxels.
 /// Adding kNeighbourKey[s] to a key gives the key of the block one step up along the axes in s (no carries:
@@ -96,15 +121,14 @@ struct BlockSet {
 
 struct BlockRecord {
   std::uint64_t key;
-  const Leaf* leaf;
+  const Leaf* leaf;     ///< null: a constant block (an active tile)
   float constant;
-  int priority;  ///< a leaf (0) wins over an active tile (1) over an empty neighbour (2) with the same key
-  bool operator<(const BlockRecord& o) const { return key != o.key ? key < o.key : priority < o.priority; }
+  std::uint8_t needed;  ///< bit d: the block origin − 8·d (bit a of d = one block lower along axis a) is needed
+  bool operator<(const BlockRecord& o) const { return key < o.key; }
 };
 
-/// Which of the 8 blocks at origin − 8·d (bit a of d = one block lower along axis a) hold cells with a corner
-/// among the leaf's active voxels: bit d of the result.
-unsigned lower_blocks_needed(const Leaf::NodeMaskType& mask) {
+/// Which lower blocks hold cells with a corner among the leaf's active voxels (BlockRecord::needed).
+std::uint8_t lower_blocks_needed(const Leaf::NodeMaskType& mask) {
   // Mask word w holds the voxels with x == w; in a word, bits 0..7 have y == 0 and every eighth bit z == 0.
   constexpr std::uint64_t kY0 = 0xFFull, kZ0 = 0x0101010101010101ull;
   std::uint64_t y0 = 0, z0 = 0, yz0 = 0;
@@ -118,68 +142,86 @@ unsigned lower_blocks_needed(const Leaf::NodeMaskType& mask) {
   const bool low[8] = {true, x0 != 0, y0 != 0, (x0 & kY0) != 0, z0 != 0, (x0 & kZ0) != 0, yz0 != 0, (x0 & 1u) != 0};
   unsigned needed = 0;
   for (unsigned d = 0; d < 8; ++d) needed |= unsigned(low[d]) << d;
-  return needed;
+  return std::uint8_t(needed);
 }
 
-/// Every leaf block with active voxels, plus the blocks below it (−x, −y, −z and their combinations) whose
-/// cells reach into it. Active tiles above leaf level are covered block by block.
+/// Every leaf with active voxels and every 8³ block of an active tile above leaf level (distinct keys).
 std::vector<BlockRecord> collect_records(const Tree& tree) {
   std::vector<BlockRecord> records;
-  auto add = [&](const openvdb::Coord& origin, unsigned needed, const Leaf* leaf, float constant, int priority) {
+  records.reserve(tree.leafCount());
+  auto add = [&](const openvdb::Coord& origin, const Leaf* leaf, float constant, std::uint8_t needed) {
     constexpr int kLimit = (1 << 23) - 2 * kB;  // block_key holds ±2^20 blocks per axis
     if (std::abs(origin.x()) > kLimit || std::abs(origin.y()) > kLimit || std::abs(origin.z()) > kLimit)
       throw InvalidInput("marching cubes: active voxels beyond index ±2^23 are not supported");
-    records.push_back({block_key(origin), leaf, constant, priority});
-    for (unsigned d = 1; d < 8; ++d)
-      if ((needed >> d) & 1u)
-        records.push_back({block_key(origin.offsetBy(d & 1 ? -kB : 0, d & 2 ? -kB : 0, d & 4 ? -kB : 0)), nullptr,
-                           tree.background(), 2});
+    records.push_back({block_key(origin), leaf, constant, needed});
   };
   for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf)
-    if (!leaf->getValueMask().isOff()) add(leaf->origin(), lower_blocks_needed(leaf->getValueMask()), &*leaf, 0, 0);
+    if (!leaf->getValueMask().isOff()) add(leaf->origin(), &*leaf, 0, lower_blocks_needed(leaf->getValueMask()));
   Tree::ValueOnCIter tile = tree.cbeginValueOn();
   tile.setMaxDepth(Tree::ValueOnCIter::LEAF_DEPTH - 1);  // tiles only, not every active voxel
   for (; tile; ++tile) {
     const openvdb::CoordBBox box = tile.getBoundingBox();
     for (int z = box.min().z(); z <= box.max().z(); z += kB)
       for (int y = box.min().y(); y <= box.max().y(); y += kB)
-        for (int x = box.min().x(); x <= box.max().x(); x += kB)
-          add(openvdb::Coord(x, y, z), 0xFFu, nullptr, tile.getValue(), 1);
+        for (int x = box.min().x(); x <= box.max().x(); x += kB) add(openvdb::Coord(x, y, z), nullptr, tile.getValue(), 0xFF);
   }
   return records;
 }
 
+/// For each step s in 1..7 and each b in [0, n) with include(b, s): finds key_of(b) + sign·step(s) among the
+/// sorted `keys` and calls found(b, s, index or keys.size()). Both sequences are increasing in b, so each
+/// direction is one merge-like sweep.
+template <typename Include, typename Found>
+void sweep_neighbours(const std::vector<std::uint64_t>& keys, std::size_t n, const std::uint64_t* key_of, int sign,
+                      const Include& include, const Found& found) {
+  for (int s = 1; s < 8; ++s) {
+    std::size_t j = 0;
+    for (std::size_t b = 0; b < n; ++b) {
+      if (!include(b, s)) continue;
+      const std::uint64_t target = sign > 0 ? key_of[b] + neighbour_key_step(s) : key_of[b] - neighbour_key_step(s);
+      while (j < keys.size() && keys[j] < target) ++j;
+      found(b, s, j < keys.size() && keys[j] == target ? j : keys.size());
+    }
+  }
+}
+
+/// The records plus their needed lower blocks that are not records themselves (they read as background),
+/// sorted by key, with each block's upper neighbours.
 BlockSet collect_blocks(const Tree& tree, bool threaded) {
   std::vector<BlockRecord> records = collect_records(tree);
-  // Records with equal keys and priorities are identical, so any sort gives the same sequence.
-  if (threaded)
+  if (threaded)  // keys are distinct, so any sort gives the same order
     tbb::parallel_sort(records.begin(), records.end());
   else
     std::sort(records.begin(), records.end());
-  records.erase(std::unique(records.begin(), records.end(),
-                            [](const BlockRecord& a, const BlockRecord& b) { return a.key == b.key; }),
-                records.end());
+  std::vector<std::uint64_t> record_keys(records.size()), extra;
+  for (std::size_t b = 0; b < records.size(); ++b) record_keys[b] = records[b].key;
+  sweep_neighbours(
+      record_keys, records.size(), record_keys.data(), -1, [&](std::size_t b, int s) { return (records[b].needed >> s) & 1u; },
+      [&](std::size_t b, int s, std::size_t found) {
+        if (found == records.size()) extra.push_back(records[b].key - neighbour_key_step(s));
+      });
+  std::sort(extra.begin(), extra.end());
+  extra.erase(std::unique(extra.begin(), extra.end()), extra.end());
+
   BlockSet set;
-  const std::size_t n = records.size();
+  const std::size_t n = records.size() + extra.size();
+  std::vector<std::uint64_t> keys(n);
   set.origins.resize(n);
   set.leaves.resize(n);
   set.constants.resize(n);
   set.neighbours.resize(n);
-  for (std::size_t b = 0; b < n; ++b) {
-    set.origins[b] = block_origin(records[b].key);
-    set.leaves[b] = records[b].leaf;
-    set.constants[b] = records[b].constant;
+  for (std::size_t b = 0, r = 0, e = 0; b < n; ++b) {  // merge the two sorted lists
+    const bool from_record = e == extra.size() || (r < records.size() && records[r].key < extra[e]);
+    keys[b] = from_record ? records[r].key : extra[e];
+    set.leaves[b] = from_record ? records[r].leaf : nullptr;
+    set.constants[b] = from_record ? records[r].constant : tree.background();
+    from_record ? ++r : ++e;
+    set.origins[b] = block_origin(keys[b]);
     set.neighbours[b][0] = std::uint32_t(b);
   }
-  // key + step is increasing in b, so one merge-like sweep per direction finds every neighbour.
-  for (int s = 1; s < 8; ++s) {
-    std::size_t j = 0;
-    for (std::size_t b = 0; b < n; ++b) {
-      const std::uint64_t target = records[b].key + neighbour_key_step(s);
-      while (j < n && records[j].key < target) ++j;
-      set.neighbours[b][s] = std::uint32_t(j < n && records[j].key == target ? j : n);
-    }
-  }
+  sweep_neighbours(
+      keys, n, keys.data(), +1, [](std::size_t, int) { return true; },
+      [&](std::size_t b, int s, std::size_t found) { set.neighbours[b][s] = std::uint32_t(found); });
   return set;
 }
 
@@ -304,7 +346,7 @@ struct IsoContext {
   float background;
   double iso;
   float iso_f;  ///< the smallest float >= iso: a float v satisfies v >= iso exactly when v >= iso_f
-  const std::array<std::uint8_t, 256>& triangle_count;
+  const std::array<CaseCorners, 256>& cases;
   std::unique_ptr<InsideMask[]> masks;   ///< one per block, plus the background sentinel
   std::unique_ptr<std::uint8_t[]> state;  ///< kAllOutside / kAllInside / kMixed, per mask
   std::unique_ptr<OwnedEdges[]> owned;   ///< written by pass 2 for blocks with vertices only
@@ -342,7 +384,7 @@ void count_block(IsoContext& ctx, std::size_t b) {
       if (shift > 40) owned.words[w + 1] |= bits >> (64 - shift);
       std::uint64_t cases = 0;
       for (std::uint32_t cells = column_cases(rows, x, y, cases); cells; cells &= cells - 1)
-        triangles += ctx.triangle_count[(cases >> (8 * __builtin_ctz(cells))) & 0xFF];
+        triangles += ctx.cases[(cases >> (8 * __builtin_ctz(cells))) & 0xFF].corner_count / 3u;
     }
   std::uint32_t running = 0;
   for (int w = 0; w < kEdgeWords; ++w) {
@@ -352,89 +394,123 @@ void count_block(IsoContext& ctx, std::size_t b) {
   ctx.counts[b] = {running, triangles};
 }
 
-/// Voxel values of a block's corner region, read from the (up to) 8 blocks it touches.
-struct RegionValues {
-  const float* data[8];
-  const Leaf* leaf[8];
-  float constant[8];
-  float background;
-  float at(int x, int y, int z) const {
-    const int s = (x >> 3) | (y >> 3) << 1 | (z >> 3) << 2, offset = (x & 7) << 6 | (y & 7) << 3 | (z & 7);
-    if (!leaf[s]) return constant[s];
-    return leaf[s]->getValueMask().isOn(offset) ? data[s][offset] : background;
+/// Voxel values for interpolating the block's owned edges: slot 0 is the block, slots 1, 2, 4 its +x, +y, +z
+/// neighbours. Reads are branch-free: a constant block reads its one value through index mask 0, all active.
+class EdgeValues {
+ public:
+  EdgeValues(const IsoContext& ctx, std::size_t b) : background_(ctx.background) {
+    for (int s : {0, 1, 2, 4}) {
+      const std::uint32_t nb = ctx.blocks.neighbours[b][s];
+      const Leaf* leaf = nb < ctx.blocks.size() ? ctx.blocks.leaves[nb] : nullptr;
+      constant_[s] = nb < ctx.blocks.size() ? ctx.blocks.constants[nb] : ctx.background;
+      data_[s] = leaf ? leaf->buffer().data() : &constant_[s];
+      for (int w = 0; w < 8; ++w) active_[s][w] = leaf ? leaf->getValueMask().getWord<std::uint64_t>(w) : ~0ull;
+      index_mask_[s] = leaf ? Leaf::SIZE - 1 : 0;
+    }
   }
+  /// Value of voxel `offset` (x << 6 | y << 3 | z) of the block in `slot`; inactive voxels read as background.
+  float at(int slot, int offset) const {
+    const int o = offset & index_mask_[slot];
+    const float v = data_[slot][o];
+    return (active_[slot][o >> 6] >> (o & 63)) & 1u ? v : background_;
+  }
+
+ private:
+  const float* data_[5];
+  std::uint64_t active_[5][8];
+  int index_mask_[5];
+  float constant_[5];
+  float background_;
 };
 
 /// Pass 3, vertices: one per owned cut edge in edge-id order, interpolated from the lower end point so the
-/// position does not depend on the cell. local[id] receives each vertex's global index.
-void emit_vertices(const IsoContext& ctx, std::size_t b, const std::uint32_t rows[kR * kR], const IndexToWorld& to_world,
-                   Vec3f* positions, std::uint32_t* local) {
-  const auto& nb = ctx.blocks.neighbours[b];
-  RegionValues values;
-  values.background = ctx.background;
-  for (int s = 0; s < 8; ++s) {
-    values.leaf[s] = nb[s] < ctx.blocks.size() ? ctx.blocks.leaves[nb[s]] : nullptr;
-    values.data[s] = values.leaf[s] ? values.leaf[s]->buffer().data() : nullptr;
-    values.constant[s] = nb[s] < ctx.blocks.size() ? ctx.blocks.constants[nb[s]] : ctx.background;
-  }
+/// position does not depend on the cell. local[region_edge()] receives each vertex's global index.
+void emit_vertices(const IsoContext& ctx, std::size_t b, const IndexToWorld& to_world, Vec3f* positions,
+                   std::uint32_t* local) {
+  const EdgeValues values(ctx, b);
+  const OwnedEdges& owned = ctx.owned[b];
   const openvdb::Coord& origin = ctx.blocks.origins[b];
   auto next = std::uint32_t(ctx.vertex_offset[b]);
-  for (int x = 0; x < kB; ++x)
-    for (int y = 0; y < kB; ++y) {
-      const auto cut = column_cut_edges(rows, x, y);
-      for (std::uint32_t any = cut[0] | cut[1] | cut[2]; any; any &= any - 1) {
-        const int z = __builtin_ctz(any);
-        const double f0 = values.at(x, y, z);
-        for (int axis = 0; axis < 3; ++axis) {
-          if (!((cut[axis] >> z) & 1u)) continue;
-          const double f1 = values.at(x + (axis == 0), y + (axis == 1), z + (axis == 2));
-          double t = (ctx.iso - f0) / (f1 - f0);
-          if (!(t >= kEdgeClamp)) t = kEdgeClamp;  // also catches NaN
-          if (t > 1.0 - kEdgeClamp) t = 1.0 - kEdgeClamp;
-          openvdb::Vec3d p_is(origin.x() + x, origin.y() + y, origin.z() + z);
-          p_is[axis] += t;
-          local[edge_id(x, y, z, axis)] = next;
-          positions[next++] = to_world(p_is);
-        }
-      }
+  // One loop over the set bits: no per-axis branches, whose misprediction would serialise the loads.
+  for (int w = 0; w < kEdgeWords; ++w)
+    for (std::uint64_t bits = owned.words[w]; bits; bits &= bits - 1) {
+      const int id = 64 * w + __builtin_ctzll(bits), cell = id / 3, axis = id - 3 * cell;
+      const int x = cell >> 6, y = (cell >> 3) & 7, z = cell & 7;  // cell = leaf offset of the lower end
+      const int shift = 6 - 3 * axis;                              // offset step 1 << shift along axis
+      const bool crosses = ((cell >> shift) & 7) == kB - 1;        // upper end in the +axis neighbour
+      const double f0 = values.at(0, cell);
+      const double f1 = values.at(crosses ? 1 << axis : 0, cell + (crosses ? -(kB - 1) : 1) * (1 << shift));
+      double t = (ctx.iso - f0) / (f1 - f0);
+      t = t > kEdgeClamp ? t : kEdgeClamp;  // maxsd/minsd: branch-free, and NaN becomes kEdgeClamp
+      t = t < 1.0 - kEdgeClamp ? t : 1.0 - kEdgeClamp;
+      // Selects instead of p_is[axis] += t: a store into the vector then read whole stalls store forwarding.
+      const openvdb::Vec3d p_is(double(origin.x() + x) + (axis == 0 ? t : 0.0),
+                                double(origin.y() + y) + (axis == 1 ? t : 0.0),
+                                double(origin.z() + z) + (axis == 2 ? t : 0.0));
+      local[region_edge(x, y, z, axis)] = next;
+      positions[next++] = to_world(p_is);
     }
 }
 
-/// Global vertex index of cube edge e of cell (x, y, z): from `local` when this block owns it, else from the
-/// owning upper neighbour's pass-2 bits.
-inline std::uint32_t corner_vertex(const IsoContext& ctx, std::size_t b, const std::uint32_t* local, int x, int y,
-                                   int z, int e) {
-  const int start = detail::kEdgeStart[e];
-  const int px = x + (start & 1), py = y + ((start >> 1) & 1), pz = z + ((start >> 2) & 1);
-  const int id = edge_id(px & 7, py & 7, pz & 7, detail::edge_axis(e));
-  const int slot = (px >> 3) | (py >> 3) << 1 | (pz >> 3) << 2;
-  if (slot == 0) return local[id];
-  const std::uint32_t owner = ctx.blocks.neighbours[b][slot];
-  RAYSIFT_DCHECK(owner < ctx.blocks.size() && ctx.counts[owner].vertices > 0);
-  return std::uint32_t(ctx.vertex_offset[owner]) + ctx.owned[owner].index(id);
+/// local[region_edge()] for the cut edges on the block's upper faces (a coordinate 8), which the upper
+/// neighbours own: their vertex offset plus the edge's rank among their owned edges (pass 2).
+void link_neighbour_vertices(const IsoContext& ctx, std::size_t b, const std::uint32_t rows[kR * kR],
+                             std::uint32_t* local) {
+  auto link = [&](std::uint32_t cut, int x, int y, int axis) {
+    const int slot = (x >> 3) | (y >> 3) << 1;
+    for (; cut; cut &= cut - 1) {
+      const int z = __builtin_ctz(cut);
+      const std::uint32_t owner = ctx.blocks.neighbours[b][slot | (z >> 3) << 2];
+      RAYSIFT_DCHECK(owner < ctx.blocks.size() && ctx.counts[owner].vertices > 0);
+      local[region_edge(x, y, z, axis)] =
+          std::uint32_t(ctx.vertex_offset[owner]) + ctx.owned[owner].index(edge_id(x & 7, y & 7, z & 7, axis));
+    }
+  };
+  for (int y = 0; y < kR; ++y) {  // face x = 8: y- and z-edges
+    const std::uint32_t r = rows[kB * kR + y];
+    link((r ^ (r >> 1)) & 0xFFu, kB, y, 2);
+    if (y < kB) link((r ^ rows[kB * kR + y + 1]) & 0x1FFu, kB, y, 1);
+  }
+  for (int x = 0; x < kB; ++x) {  // face y = 8: x- and z-edges
+    const std::uint32_t r = rows[x * kR + kB];
+    link((r ^ (r >> 1)) & 0xFFu, x, kB, 2);
+    link((r ^ rows[(x + 1) * kR + kB]) & 0x1FFu, x, kB, 0);
+  }
+  for (int x = 0; x < kB; ++x)  // face z = 8: x- and y-edges
+    for (int y = 0; y < kB; ++y) {
+      const std::uint32_t r = rows[x * kR + y];
+      link((r ^ rows[(x + 1) * kR + y]) & 0x100u, x, y, 0);
+      link((r ^ rows[x * kR + y + 1]) & 0x100u, x, y, 1);
+    }
 }
 
 /// Pass 3 for one block: vertices, then triangles in cell order (x, y, z) and table order.
 void fill_block(const IsoContext& ctx, std::size_t b, const IndexToWorld& to_world, bool flip, mesh::TriMesh& mesh) {
   if (ctx.counts[b].vertices == 0 && ctx.counts[b].triangles == 0) return;
+  // The values were evicted since pass 1 and cut edges touch them sparsely: fetch the next block's ahead.
+  if (b + 1 < ctx.blocks.size() && ctx.counts[b + 1].vertices > 0 && ctx.blocks.leaves[b + 1]) {
+    const float* next = ctx.blocks.leaves[b + 1]->buffer().data();
+    for (int i = 0; i < int(Leaf::SIZE); i += 16) __builtin_prefetch(next + i);
+  }
   std::uint32_t rows[kR * kR];
   block_rows(ctx, b, rows);
-  std::uint32_t local[kEdgeIds];
-  emit_vertices(ctx, b, rows, to_world, mesh.positions.data(), local);
+  std::uint32_t local[kRegionEdges];  // only the cut edges' entries are written and read
+  emit_vertices(ctx, b, to_world, mesh.positions.data(), local);
   if (ctx.counts[b].triangles == 0) return;
-  const auto& cases = detail::marching_cubes_cases();
+  link_neighbour_vertices(ctx, b, rows, local);
   std::uint32_t* out = mesh.triangles[ctx.triangle_offset[b]].data();
+  const int second = flip ? 2 : 1, third = flip ? 1 : 2;
   for (int x = 0; x < kB; ++x)
     for (int y = 0; y < kB; ++y) {
       std::uint64_t column = 0;
       for (std::uint32_t cells = column_cases(rows, x, y, column); cells; cells &= cells - 1) {
         const int z = __builtin_ctz(cells);
-        const detail::McCase& mc = cases[(column >> (8 * z)) & 0xFF];
-        for (int k = 0; k < 3 * mc.triangle_count; k += 3) {
-          out[0] = corner_vertex(ctx, b, local, x, y, z, mc.edges[k]);
-          out[flip ? 2 : 1] = corner_vertex(ctx, b, local, x, y, z, mc.edges[k + 1]);
-          out[flip ? 1 : 2] = corner_vertex(ctx, b, local, x, y, z, mc.edges[k + 2]);
-          out += 3;
+        const CaseCorners& cc = ctx.cases[(column >> (8 * z)) & 0xFF];
+        const std::uint32_t* cell = local + region_edge(x, y, z, 0);
+        for (int k = 0; k < cc.corner_count; k += 3, out += 3) {
+          out[0] = cell[cc.offset[k]];
+          out[second] = cell[cc.offset[k + 1]];
+          out[third] = cell[cc.offset[k + 2]];
         }
       }
     }
@@ -461,15 +537,10 @@ bool for_each_block(std::size_t n, const MarchingCubesOptions& options, double b
 /// One surface; `progress_begin/end` is this iso-value's share of the whole call's progress.
 mesh::TriMesh extract(const openvdb::FloatGrid& grid, const BlockSet& blocks, double iso,
                       const MarchingCubesOptions& options, double progress_begin, double progress_end) {
-  static const std::array<std::uint8_t, 256> triangle_count = [] {
-    std::array<std::uint8_t, 256> t{};
-    for (int c = 0; c < 256; ++c) t[c] = detail::marching_cubes_cases()[c].triangle_count;
-    return t;
-  }();
   float iso_f = float(iso);
   if (double(iso_f) < iso) iso_f = std::nextafter(iso_f, std::numeric_limits<float>::infinity());
   const std::size_t n = blocks.size();
-  IsoContext ctx{blocks, grid.background(), iso, iso_f, triangle_count, {}, {}, {}, {}, {}, {}};
+  IsoContext ctx{blocks, grid.background(), iso, iso_f, case_corners(), {}, {}, {}, {}, {}, {}};
   ctx.masks.reset(new InsideMask[n + 1]);
   ctx.state.reset(new std::uint8_t[n + 1]);
   ctx.owned.reset(new OwnedEdges[n]);
