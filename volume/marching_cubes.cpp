@@ -71,26 +71,31 @@ constexpr std::array<std::uint32_t, 256> make_spread3() {
 }
 constexpr std::array<std::uint32_t, 256> kSpread3 = make_spread3();
 
-/// The triangles of each case as region_edge() offsets from the cell's region_edge(x, y, z, 0).
+/// The triangles of each case as region_edge() offsets from the cell's region_edge(x, y, z, 0); unused
+/// entries are 0 (fill_block copies all of them to avoid a branch on the count).
 struct CaseCorners {
   std::uint8_t corner_count = 0;  ///< 3 per triangle
   std::array<std::int16_t, 3 * detail::kMcMaxTriangles> offset{};
 };
+using CaseTable = std::array<CaseCorners, 256>;
 
-const std::array<CaseCorners, 256>& case_corners() {
-  static const std::array<CaseCorners, 256> table = [] {
-    std::array<CaseCorners, 256> t;
+/// The table with the generator's orientation, or with every triangle reversed.
+const CaseTable& case_corners(bool flip) {
+  static const std::array<CaseTable, 2> tables = [] {
+    std::array<CaseTable, 2> t;
     for (int c = 0; c < 256; ++c) {
       const detail::McCase& mc = detail::marching_cubes_cases()[c];
-      t[c].corner_count = std::uint8_t(3 * mc.triangle_count);
-      for (int k = 0; k < t[c].corner_count; ++k) {
+      for (int k = 0; k < 3 * mc.triangle_count; ++k) {
         const int e = mc.edges[k], start = detail::kEdgeStart[e];
-        t[c].offset[k] = std::int16_t(region_edge(start & 1, (start >> 1) & 1, (start >> 2) & 1, detail::edge_axis(e)));
+        const int offset = region_edge(start & 1, (start >> 1) & 1, (start >> 2) & 1, detail::edge_axis(e));
+        const int flipped = k % 3 == 0 ? k : k % 3 == 1 ? k + 1 : k - 1;
+        t[0][c].offset[k] = t[1][c].offset[flipped] = std::int16_t(offset);
       }
+      t[0][c].corner_count = t[1][c].corner_count = std::uint8_t(3 * mc.triangle_count);
     }
     return t;
   }();
-  return table;
+  return tables[flip];
 }
 
 /// Orders block origins by (z, y, x); origins are multiples of 8, so 21 bits per axis cover ±2^23 voxels.
@@ -346,7 +351,7 @@ struct IsoContext {
   float background;
   double iso;
   float iso_f;  ///< the smallest float >= iso: a float v satisfies v >= iso exactly when v >= iso_f
-  const std::array<CaseCorners, 256>& cases;
+  const CaseTable& cases;  ///< for the triangle counts
   std::unique_ptr<InsideMask[]> masks;   ///< one per block, plus the background sentinel
   std::unique_ptr<std::uint8_t[]> state;  ///< kAllOutside / kAllInside / kMixed, per mask
   std::unique_ptr<OwnedEdges[]> owned;   ///< written by pass 2 for blocks with vertices only
@@ -485,7 +490,8 @@ void link_neighbour_vertices(const IsoContext& ctx, std::size_t b, const std::ui
 }
 
 /// Pass 3 for one block: vertices, then triangles in cell order (x, y, z) and table order.
-void fill_block(const IsoContext& ctx, std::size_t b, const IndexToWorld& to_world, bool flip, mesh::TriMesh& mesh) {
+void fill_block(const IsoContext& ctx, std::size_t b, const IndexToWorld& to_world, const CaseTable& corners,
+                mesh::TriMesh& mesh) {
   if (ctx.counts[b].vertices == 0 && ctx.counts[b].triangles == 0) return;
   // The values were evicted since pass 1 and cut edges touch them sparsely: fetch the next block's ahead.
   if (b + 1 < ctx.blocks.size() && ctx.counts[b + 1].vertices > 0 && ctx.blocks.leaves[b + 1]) {
@@ -494,26 +500,27 @@ void fill_block(const IsoContext& ctx, std::size_t b, const IndexToWorld& to_wor
   }
   std::uint32_t rows[kR * kR];
   block_rows(ctx, b, rows);
-  std::uint32_t local[kRegionEdges];  // only the cut edges' entries are written and read
-  emit_vertices(ctx, b, to_world, mesh.positions.data(), local);
+  // Vertex index per region edge. Entries of edges that are not cut hold zeros or stale (but defined) values
+  // from earlier blocks; only the fixed-length copies below read them, into slots that are then overwritten.
+  thread_local std::array<std::uint32_t, kRegionEdges> local{};
+  emit_vertices(ctx, b, to_world, mesh.positions.data(), local.data());
   if (ctx.counts[b].triangles == 0) return;
-  link_neighbour_vertices(ctx, b, rows, local);
-  std::uint32_t* out = mesh.triangles[ctx.triangle_offset[b]].data();
-  const int second = flip ? 2 : 1, third = flip ? 1 : 2;
+  link_neighbour_vertices(ctx, b, rows, local.data());
+  constexpr int kCorners = 3 * detail::kMcMaxTriangles;
+  std::uint32_t buffer[kB * kB * kB * kCorners + kCorners];  // in L1, then one copy to the mesh
+  std::uint32_t* out = buffer;
   for (int x = 0; x < kB; ++x)
     for (int y = 0; y < kB; ++y) {
       std::uint64_t column = 0;
       for (std::uint32_t cells = column_cases(rows, x, y, column); cells; cells &= cells - 1) {
         const int z = __builtin_ctz(cells);
-        const CaseCorners& cc = ctx.cases[(column >> (8 * z)) & 0xFF];
-        const std::uint32_t* cell = local + region_edge(x, y, z, 0);
-        for (int k = 0; k < cc.corner_count; k += 3, out += 3) {
-          out[0] = cell[cc.offset[k]];
-          out[second] = cell[cc.offset[k + 1]];
-          out[third] = cell[cc.offset[k + 2]];
-        }
+        const CaseCorners& cc = corners[(column >> (8 * z)) & 0xFF];
+        const std::uint32_t* cell = local.data() + region_edge(x, y, z, 0);
+        for (int k = 0; k < kCorners; ++k) out[k] = cell[cc.offset[k]];  // no branch on the triangle count
+        out += cc.corner_count;
       }
     }
+  std::copy(buffer, out, mesh.triangles[ctx.triangle_offset[b]].data());
 }
 
 /// Runs fn(b) for every block in chunks of kChunk, checking the cancel flag before each chunk and reporting
@@ -540,7 +547,7 @@ mesh::TriMesh extract(const openvdb::FloatGrid& grid, const BlockSet& blocks, do
   float iso_f = float(iso);
   if (double(iso_f) < iso) iso_f = std::nextafter(iso_f, std::numeric_limits<float>::infinity());
   const std::size_t n = blocks.size();
-  IsoContext ctx{blocks, grid.background(), iso, iso_f, case_corners(), {}, {}, {}, {}, {}, {}};
+  IsoContext ctx{blocks, grid.background(), iso, iso_f, case_corners(false), {}, {}, {}, {}, {}, {}};
   ctx.masks.reset(new InsideMask[n + 1]);
   ctx.state.reset(new std::uint8_t[n + 1]);
   ctx.owned.reset(new OwnedEdges[n]);
@@ -565,8 +572,9 @@ mesh::TriMesh extract(const openvdb::FloatGrid& grid, const BlockSet& blocks, do
   mesh.positions.resize(ctx.vertex_offset[n]);
   mesh.triangles.resize(ctx.triangle_offset[n]);
   const IndexToWorld to_world(grid.transform());
+  const CaseTable& corners = case_corners(options.flip_orientation);
   if (!for_each_block(n, options, progress_begin + 0.5 * span, progress_end, [&](std::size_t b) {
-        fill_block(ctx, b, to_world, options.flip_orientation, mesh);
+        fill_block(ctx, b, to_world, corners, mesh);
       }))
     return {};
   return mesh;
