@@ -1,5 +1,6 @@
 #include "volume/marching_cubes.h"
 
+#include <tbb/parallel_invoke.h>
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
@@ -236,13 +237,17 @@ BlockSet collect_blocks(const Tree& tree, bool threaded) {
 class IndexToWorld {
  public:
   explicit IndexToWorld(const openvdb::math::Transform& xform) : xform_(xform), linear_(xform.isLinear()) {
-    if (linear_) m_ = xform.baseMap()->getAffineMap()->getMat4();
+    if (!linear_) return;
+    m_ = xform.baseMap()->getAffineMap()->getMat4();
+    diagonal_ = m_[0][1] == 0 && m_[0][2] == 0 && m_[1][0] == 0 && m_[1][2] == 0 && m_[2][0] == 0 && m_[2][1] == 0;
   }
   Vec3f operator()(const openvdb::Vec3d& p) const {
     if (!linear_) {
       const openvdb::Vec3d w = xform_.indexToWorld(p);
       return {float(w.x()), float(w.y()), float(w.z())};
     }
+    // Scale + translate (the usual map): the zero terms of the full product would add nothing.
+    if (diagonal_) return {float(p[0] * m_[0][0] + m_[3][0]), float(p[1] * m_[1][1] + m_[3][1]), float(p[2] * m_[2][2] + m_[3][2])};
     auto row = [&](int c) { return float(p[0] * m_[0][c] + p[1] * m_[1][c] + p[2] * m_[2][c] + m_[3][c]); };
     return {row(0), row(1), row(2)};
   }
@@ -250,6 +255,7 @@ class IndexToWorld {
  private:
   const openvdb::math::Transform& xform_;
   bool linear_;
+  bool diagonal_ = false;
   openvdb::math::Mat4d m_;
 };
 
@@ -432,29 +438,37 @@ class EdgeValues {
 /// position does not depend on the cell. local[region_edge()] receives each vertex's global index.
 void emit_vertices(const IsoContext& ctx, std::size_t b, const IndexToWorld& to_world, Vec3f* positions,
                    std::uint32_t* local) {
+  // First gather both end values of every owned cut edge (independent loads that overlap their cache
+  // misses), then interpolate. Each is one loop over the set bits, without per-axis branches.
   const EdgeValues values(ctx, b);
   const OwnedEdges& owned = ctx.owned[b];
+  std::uint16_t ids[kEdgeIds];
+  float f0s[kEdgeIds], f1s[kEdgeIds];
+  int count = 0;
+  for (int w = 0; w < kEdgeWords; ++w)
+    for (std::uint64_t bits = owned.words[w]; bits; bits &= bits - 1, ++count) {
+      const int id = 64 * w + __builtin_ctzll(bits), cell = id / 3, axis = id - 3 * cell;
+      const int shift = 6 - 3 * axis;                        // cell = leaf offset of the lower end; step 1 << shift
+      const bool crosses = ((cell >> shift) & 7) == kB - 1;  // upper end in the +axis neighbour
+      ids[count] = std::uint16_t(id);
+      f0s[count] = values.at(0, cell);
+      f1s[count] = values.at(crosses ? 1 << axis : 0, cell + (crosses ? -(kB - 1) : 1) * (1 << shift));
+    }
   const openvdb::Coord& origin = ctx.blocks.origins[b];
   auto next = std::uint32_t(ctx.vertex_offset[b]);
-  // One loop over the set bits: no per-axis branches, whose misprediction would serialise the loads.
-  for (int w = 0; w < kEdgeWords; ++w)
-    for (std::uint64_t bits = owned.words[w]; bits; bits &= bits - 1) {
-      const int id = 64 * w + __builtin_ctzll(bits), cell = id / 3, axis = id - 3 * cell;
-      const int x = cell >> 6, y = (cell >> 3) & 7, z = cell & 7;  // cell = leaf offset of the lower end
-      const int shift = 6 - 3 * axis;                              // offset step 1 << shift along axis
-      const bool crosses = ((cell >> shift) & 7) == kB - 1;        // upper end in the +axis neighbour
-      const double f0 = values.at(0, cell);
-      const double f1 = values.at(crosses ? 1 << axis : 0, cell + (crosses ? -(kB - 1) : 1) * (1 << shift));
-      double t = (ctx.iso - f0) / (f1 - f0);
-      t = t > kEdgeClamp ? t : kEdgeClamp;  // maxsd/minsd: branch-free, and NaN becomes kEdgeClamp
-      t = t < 1.0 - kEdgeClamp ? t : 1.0 - kEdgeClamp;
-      // Selects instead of p_is[axis] += t: a store into the vector then read whole stalls store forwarding.
-      const openvdb::Vec3d p_is(double(origin.x() + x) + (axis == 0 ? t : 0.0),
-                                double(origin.y() + y) + (axis == 1 ? t : 0.0),
-                                double(origin.z() + z) + (axis == 2 ? t : 0.0));
-      local[region_edge(x, y, z, axis)] = next;
-      positions[next++] = to_world(p_is);
-    }
+  for (int i = 0; i < count; ++i) {
+    const int cell = ids[i] / 3, axis = ids[i] - 3 * cell, x = cell >> 6, y = (cell >> 3) & 7, z = cell & 7;
+    const double f0 = f0s[i];
+    double t = (ctx.iso - f0) / (double(f1s[i]) - f0);
+    t = t > kEdgeClamp ? t : kEdgeClamp;  // maxsd/minsd: branch-free, and NaN becomes kEdgeClamp
+    t = t < 1.0 - kEdgeClamp ? t : 1.0 - kEdgeClamp;
+    // Selects instead of p_is[axis] += t: a store into the vector then read whole stalls store forwarding.
+    const openvdb::Vec3d p_is(double(origin.x() + x) + (axis == 0 ? t : 0.0),
+                              double(origin.y() + y) + (axis == 1 ? t : 0.0),
+                              double(origin.z() + z) + (axis == 2 ? t : 0.0));
+    local[region_edge(x, y, z, axis)] = next;
+    positions[next++] = to_world(p_is);
+  }
 }
 
 /// local[region_edge()] for the cut edges on the block's upper faces (a coordinate 8), which the upper
@@ -569,8 +583,15 @@ mesh::TriMesh extract(const openvdb::FloatGrid& grid, const BlockSet& blocks, do
   }
   if (ctx.vertex_offset[n] > UINT32_MAX) throw InvalidInput("marching cubes: more than 2^32 vertices");
   mesh::TriMesh mesh;
-  mesh.positions.resize(ctx.vertex_offset[n]);
-  mesh.triangles.resize(ctx.triangle_offset[n]);
+  // The zero-filling (and first-touch page faults) of the two arrays costs as much as a pass: overlap them.
+  auto size_positions = [&] { mesh.positions.resize(ctx.vertex_offset[n]); };
+  auto size_triangles = [&] { mesh.triangles.resize(ctx.triangle_offset[n]); };
+  if (options.threaded) {
+    tbb::parallel_invoke(size_positions, size_triangles);
+  } else {
+    size_positions();
+    size_triangles();
+  }
   const IndexToWorld to_world(grid.transform());
   const CaseTable& corners = case_corners(options.flip_orientation);
   if (!for_each_block(n, options, progress_begin + 0.5 * span, progress_end, [&](std::size_t b) {

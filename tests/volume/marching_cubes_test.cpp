@@ -1,5 +1,6 @@
 // Marching cubes on analytic volumes: measures against closed forms, topology invariants, all 256 cube
-// configurations, ties with integer data, thread-count independence and sparsity.
+// configurations, ties with integer data, thread-count independence and sparsity; plus the manifold check on
+// the bundled engine CT, and cancellation / progress.
 #include "volume/marching_cubes.h"
 
 #include <gtest/gtest.h>
@@ -14,6 +15,9 @@
 #include "mesh/mesh_analysis.h"
 #include "volume/detail/vdb_grid.h"
 #include "volume/generate.h"
+#include "volume/iso_values.h"
+#include "volume/transfer_function.h"
+#include "volume/vdb_io.h"
 
 namespace raysift::volume {
 namespace {
@@ -254,6 +258,58 @@ TEST(MarchingCubes, ActiveTilesAreMeshed) {
   const MeshAnalysis a = analyze_mesh(extract_isosurface(Volume(impl), 0.5));
   EXPECT_TRUE(a.is_watertight());
   EXPECT_NEAR(a.signed_volume, 8.0 * 8 * 8, 8.0 * 8 * 8 * 0.05);
+}
+
+TEST(MarchingCubes, EngineCtSurfacesAreClosedManifolds) {
+  // Real CT data (u8 values, many ties, ambiguous faces and cells everywhere) at the iso-values the bundled
+  // TF picks and the bench's 80 and 150. Every edge in exactly two triangles with opposite orientation and
+  // every vertex a single fan: the surfaces can go straight to decimation, no fan stripping needed.
+  const Volume engine = load_vdb(RAYSIFT_SOURCE_DIR "/datasets/engine_ct.vdb");
+  std::vector<double> isos = {80.0, 150.0};
+  for (const IsoValue& v : select_iso_values(engine, load_transfer_function(RAYSIFT_SOURCE_DIR "/datasets/engine_ct_tf.json")))
+    isos.push_back(v.value);
+  ASSERT_GE(isos.size(), 3u);
+  const std::vector<TriMesh> meshes = extract_isosurfaces(engine, isos);
+  for (std::size_t i = 0; i < isos.size(); ++i) {
+    const MeshAnalysis a = analyze_mesh(meshes[i]);
+    EXPECT_GT(a.faces, 50000u) << isos[i];
+    EXPECT_TRUE(a.is_watertight()) << "iso " << isos[i] << ": boundary " << a.boundary_edges << ", non-manifold edges "
+                                   << a.non_manifold_edges << ", inconsistent " << a.inconsistent_edges;
+    EXPECT_EQ(a.non_manifold_vertices, 0u) << isos[i];
+    EXPECT_EQ(a.degenerate_faces, 0u) << isos[i];
+    const std::vector<mesh::VertexKind> kinds = mesh::classify_vertices(meshes[i]);
+    EXPECT_EQ(std::count(kinds.begin(), kinds.end(), mesh::VertexKind::Interior), std::ptrdiff_t(kinds.size()))
+        << isos[i];
+  }
+}
+
+TEST(MarchingCubes, CancelledCallReturnsEmptyMeshes) {
+  BlobsOptions blobs;
+  blobs.grid.dims = {48, 48, 48};
+  const Volume v = make_blobs(blobs);
+  std::atomic<bool> cancel{true};
+  MarchingCubesOptions o;
+  o.cancel = &cancel;
+  const std::vector<double> isos = {0.2, 0.5};
+  for (const TriMesh& m : extract_isosurfaces(v, isos, o)) EXPECT_TRUE(m.positions.empty() && m.triangles.empty());
+  cancel = false;
+  EXPECT_EQ(extract_isosurface(v, 0.2, o).triangles, extract_isosurface(v, 0.2).triangles);
+}
+
+TEST(MarchingCubes, ProgressRisesToOne) {
+  BlobsOptions blobs;
+  blobs.grid.dims = {64, 64, 64};
+  const Volume v = make_blobs(blobs);
+  MarchingCubesOptions o;
+  o.threaded = false;  // one reporting thread, so the reports arrive in order
+  std::vector<double> reports;
+  o.progress = [&](double f) { reports.push_back(f); };
+  const std::vector<double> isos = {0.2, 0.5};
+  extract_isosurfaces(v, isos, o);
+  ASSERT_GE(reports.size(), 6u);  // at least one per pass and iso-value
+  EXPECT_TRUE(std::is_sorted(reports.begin(), reports.end()));
+  EXPECT_GT(reports.front(), 0.0);
+  EXPECT_DOUBLE_EQ(reports.back(), 1.0);
 }
 
 TEST(MarchingCubes, IsoOutsideRangeGivesEmptyMesh) {
