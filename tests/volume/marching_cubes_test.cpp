@@ -68,6 +68,40 @@ TEST(MarchingCubes, WorldTransformScalesPositions) {
   EXPECT_NEAR(a.bbox.center().x, 23.5 * 0.5, 0.05);
 }
 
+TEST(MarchingCubes, VerticesLieOnGridEdgesUnderAnyTransform) {
+  // The world positions mapped back by OpenVDB's own inverse must sit on a grid edge: two index coordinates
+  // integral, the third at least kEdgeClamp from both ends. Covers the scale+translate fast path, a general
+  // affine map (rotation) and a non-linear (frustum) map.
+  BallOptions ball;
+  ball.grid.dims = {24, 24, 24};
+  ball.radius_voxels = 8.0;
+  const Volume base = make_ball(ball);
+  openvdb::math::Transform::Ptr rotated = openvdb::math::Transform::createLinearTransform(0.7);
+  rotated->preRotate(0.4, openvdb::math::X_AXIS);
+  rotated->postTranslate(openvdb::Vec3d(3, -2, 5));
+  const openvdb::math::Transform::Ptr transforms[] = {
+      openvdb::math::Transform::createLinearTransform(0.5), rotated,
+      openvdb::math::Transform::createFrustumTransform(openvdb::BBoxd({0, 0, 0}, {24, 24, 24}), 0.5, 10.0, 1.0)};
+  for (const auto& xform : transforms) {
+    auto impl = std::make_shared<Volume::Impl>();
+    impl->grid = base.impl().grid->deepCopy();
+    impl->grid->setTransform(xform);
+    const TriMesh m = extract_isosurface(Volume(impl), 0.5);
+    ASSERT_GT(m.triangle_count(), 100u) << xform->mapType();
+    EXPECT_TRUE(analyze_mesh(m).is_closed_manifold()) << xform->mapType();
+    for (const Vec3f& p : m.positions) {
+      const openvdb::Vec3d p_is = xform->worldToIndex(openvdb::Vec3d(p.x, p.y, p.z));
+      int integral = 0;
+      for (int a = 0; a < 3; ++a) {
+        const double frac = std::abs(p_is[a] - std::round(p_is[a]));
+        if (frac < 1e-3) ++integral;
+        else ASSERT_GT(frac, kEdgeClamp - 1e-3) << xform->mapType() << " " << p_is;
+      }
+      ASSERT_EQ(integral, 2) << xform->mapType() << " " << p_is;
+    }
+  }
+}
+
 TEST(MarchingCubes, FlipReversesOrientation) {
   BallOptions ball;
   ball.grid.dims = {24, 24, 24};
