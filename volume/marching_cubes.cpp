@@ -507,11 +507,6 @@ void link_neighbour_vertices(const IsoContext& ctx, std::size_t b, const std::ui
 void fill_block(const IsoContext& ctx, std::size_t b, const IndexToWorld& to_world, const CaseTable& corners,
                 mesh::TriMesh& mesh) {
   if (ctx.counts[b].vertices == 0 && ctx.counts[b].triangles == 0) return;
-  // The values were evicted since pass 1 and cut edges touch them sparsely: fetch the next block's ahead.
-  if (b + 1 < ctx.blocks.size() && ctx.counts[b + 1].vertices > 0 && ctx.blocks.leaves[b + 1]) {
-    const float* next = ctx.blocks.leaves[b + 1]->buffer().data();
-    for (int i = 0; i < int(Leaf::SIZE); i += 16) __builtin_prefetch(next + i);
-  }
   std::uint32_t rows[kR * kR];
   block_rows(ctx, b, rows);
   // Vertex index per region edge. Entries of edges that are not cut hold zeros or stale (but defined) values
