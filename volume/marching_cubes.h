@@ -22,6 +22,12 @@ struct MarchingCubesOptions {
   /// normals point toward decreasing values (out of dense material). True reverses every triangle.
   bool flip_orientation = false;
   bool threaded = true;  ///< false = serial path (same output)
+  /// Checked between chunks of 64 blocks; once it reads true the call returns promptly with empty meshes
+  /// (for every iso-value), so the caller, which set the flag, must not take them for results. Null = never.
+  const std::atomic<bool>* cancel = nullptr;
+  /// Called with the finished fraction of the whole call in (0, 1], from worker threads (must be thread-safe),
+  /// once per chunk of 64 blocks and pass. Empty = no reports.
+  std::function<void(double fraction)> progress;
 };
 
 /// Extracts the iso-surface {f = iso} with the inside predicate f >= iso (strict on one side). Vertices sit

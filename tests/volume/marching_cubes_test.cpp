@@ -1,5 +1,6 @@
 // Marching cubes on analytic volumes: measures against closed forms, topology invariants, all 256 cube
-// configurations, ties with integer data, thread-count independence and sparsity.
+// configurations, ties with integer data, thread-count independence and sparsity; plus the manifold check on
+// the bundled engine CT, and cancellation / progress.
 #include "volume/marching_cubes.h"
 
 #include <gtest/gtest.h>
@@ -14,6 +15,9 @@
 #include "mesh/mesh_analysis.h"
 #include "volume/detail/vdb_grid.h"
 #include "volume/generate.h"
+#include "volume/iso_values.h"
+#include "volume/transfer_function.h"
+#include "volume/vdb_io.h"
 
 namespace raysift::volume {
 namespace {
@@ -62,6 +66,40 @@ TEST(MarchingCubes, WorldTransformScalesPositions) {
   const double r_ws = 10.0;
   EXPECT_NEAR(a.signed_volume, 4.0 / 3.0 * kPi * std::pow(r_ws, 3), 0.01 * 4.0 / 3.0 * kPi * std::pow(r_ws, 3));
   EXPECT_NEAR(a.bbox.center().x, 23.5 * 0.5, 0.05);
+}
+
+TEST(MarchingCubes, VerticesLieOnGridEdgesUnderAnyTransform) {
+  // The world positions mapped back by OpenVDB's own inverse must sit on a grid edge: two index coordinates
+  // integral, the third at least kEdgeClamp from both ends. Covers the scale+translate fast path, a general
+  // affine map (rotation) and a non-linear (frustum) map.
+  BallOptions ball;
+  ball.grid.dims = {24, 24, 24};
+  ball.radius_voxels = 8.0;
+  const Volume base = make_ball(ball);
+  openvdb::math::Transform::Ptr rotated = openvdb::math::Transform::createLinearTransform(0.7);
+  rotated->preRotate(0.4, openvdb::math::X_AXIS);
+  rotated->postTranslate(openvdb::Vec3d(3, -2, 5));
+  const openvdb::math::Transform::Ptr transforms[] = {
+      openvdb::math::Transform::createLinearTransform(0.5), rotated,
+      openvdb::math::Transform::createFrustumTransform(openvdb::BBoxd({0, 0, 0}, {24, 24, 24}), 0.5, 10.0, 1.0)};
+  for (const auto& xform : transforms) {
+    auto impl = std::make_shared<Volume::Impl>();
+    impl->grid = base.impl().grid->deepCopy();
+    impl->grid->setTransform(xform);
+    const TriMesh m = extract_isosurface(Volume(impl), 0.5);
+    ASSERT_GT(m.triangle_count(), 100u) << xform->mapType();
+    EXPECT_TRUE(analyze_mesh(m).is_closed_manifold()) << xform->mapType();
+    for (const Vec3f& p : m.positions) {
+      const openvdb::Vec3d p_is = xform->worldToIndex(openvdb::Vec3d(p.x, p.y, p.z));
+      int integral = 0;
+      for (int a = 0; a < 3; ++a) {
+        const double frac = std::abs(p_is[a] - std::round(p_is[a]));
+        if (frac < 1e-3) ++integral;
+        else ASSERT_GT(frac, kEdgeClamp - 1e-3) << xform->mapType() << " " << p_is;
+      }
+      ASSERT_EQ(integral, 2) << xform->mapType() << " " << p_is;
+    }
+  }
 }
 
 TEST(MarchingCubes, FlipReversesOrientation) {
@@ -254,6 +292,58 @@ TEST(MarchingCubes, ActiveTilesAreMeshed) {
   const MeshAnalysis a = analyze_mesh(extract_isosurface(Volume(impl), 0.5));
   EXPECT_TRUE(a.is_watertight());
   EXPECT_NEAR(a.signed_volume, 8.0 * 8 * 8, 8.0 * 8 * 8 * 0.05);
+}
+
+TEST(MarchingCubes, EngineCtSurfacesAreClosedManifolds) {
+  // Real CT data (u8 values, many ties, ambiguous faces and cells everywhere) at the iso-values the bundled
+  // TF picks and the bench's 80 and 150. Every edge in exactly two triangles with opposite orientation and
+  // every vertex a single fan: the surfaces can go straight to decimation, no fan stripping needed.
+  const Volume engine = load_vdb(RAYSIFT_SOURCE_DIR "/datasets/engine_ct.vdb");
+  std::vector<double> isos = {80.0, 150.0};
+  for (const IsoValue& v : select_iso_values(engine, load_transfer_function(RAYSIFT_SOURCE_DIR "/datasets/engine_ct_tf.json")))
+    isos.push_back(v.value);
+  ASSERT_GE(isos.size(), 3u);
+  const std::vector<TriMesh> meshes = extract_isosurfaces(engine, isos);
+  for (std::size_t i = 0; i < isos.size(); ++i) {
+    const MeshAnalysis a = analyze_mesh(meshes[i]);
+    EXPECT_GT(a.faces, 50000u) << isos[i];
+    EXPECT_TRUE(a.is_watertight()) << "iso " << isos[i] << ": boundary " << a.boundary_edges << ", non-manifold edges "
+                                   << a.non_manifold_edges << ", inconsistent " << a.inconsistent_edges;
+    EXPECT_EQ(a.non_manifold_vertices, 0u) << isos[i];
+    EXPECT_EQ(a.degenerate_faces, 0u) << isos[i];
+    const std::vector<mesh::VertexKind> kinds = mesh::classify_vertices(meshes[i]);
+    EXPECT_EQ(std::count(kinds.begin(), kinds.end(), mesh::VertexKind::Interior), std::ptrdiff_t(kinds.size()))
+        << isos[i];
+  }
+}
+
+TEST(MarchingCubes, CancelledCallReturnsEmptyMeshes) {
+  BlobsOptions blobs;
+  blobs.grid.dims = {48, 48, 48};
+  const Volume v = make_blobs(blobs);
+  std::atomic<bool> cancel{true};
+  MarchingCubesOptions o;
+  o.cancel = &cancel;
+  const std::vector<double> isos = {0.2, 0.5};
+  for (const TriMesh& m : extract_isosurfaces(v, isos, o)) EXPECT_TRUE(m.positions.empty() && m.triangles.empty());
+  cancel = false;
+  EXPECT_EQ(extract_isosurface(v, 0.2, o).triangles, extract_isosurface(v, 0.2).triangles);
+}
+
+TEST(MarchingCubes, ProgressRisesToOne) {
+  BlobsOptions blobs;
+  blobs.grid.dims = {64, 64, 64};
+  const Volume v = make_blobs(blobs);
+  MarchingCubesOptions o;
+  o.threaded = false;  // one reporting thread, so the reports arrive in order
+  std::vector<double> reports;
+  o.progress = [&](double f) { reports.push_back(f); };
+  const std::vector<double> isos = {0.2, 0.5};
+  extract_isosurfaces(v, isos, o);
+  ASSERT_GE(reports.size(), 6u);  // at least one per pass and iso-value
+  EXPECT_TRUE(std::is_sorted(reports.begin(), reports.end()));
+  EXPECT_GT(reports.front(), 0.0);
+  EXPECT_DOUBLE_EQ(reports.back(), 1.0);
 }
 
 TEST(MarchingCubes, IsoOutsideRangeGivesEmptyMesh) {
