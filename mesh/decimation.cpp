@@ -33,7 +33,7 @@ static_assert(sizeof(Vec3f) == 3 * sizeof(float), "meshopt reads positions as pa
 static_assert(sizeof(std::array<std::uint32_t, 3>) == 3 * sizeof(unsigned), "meshopt reads a flat index buffer");
 
 /// meshopt runs per component (the first and its guarded re-runs) before OpenMesh's Decimater takes over.
-constexpr int kMaxRuns = 4;
+constexpr int kMaxRuns = 8;
 
 std::size_t target_face_count(const TriMesh& mesh, const DecimationOptions& o) {
   if (!(o.ratio > 0 && o.ratio <= 1)) throw InvalidInput("decimation: ratio must be in (0, 1], got " + std::to_string(o.ratio));

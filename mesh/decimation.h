@@ -51,7 +51,7 @@ struct DecimationResult {
 /// boundary edges, so open surfaces keep their outline exactly), then the guard per connected component:
 /// its result must keep the component's Euler characteristic, stay one component, keep its boundary edges
 /// and add no non-manifold edge/vertex or inconsistent edge (a closed 2-manifold stays one, same genus). A
-/// failing component is redone alone: up to 4 meshopt runs, each freezing the input triangles within k rings
+/// failing component is redone alone: up to 8 meshopt runs, each freezing the input triangles within k rings
 /// of the defects of run k; then OpenMesh's Decimater (link condition); then unchanged. Deterministic for any
 /// thread count (components are guarded in parallel).
 /// \throw InvalidInput for out-of-range options or a mesh failing validate_mesh().
