@@ -6,6 +6,7 @@
 #include <OpenMesh/Tools/Decimater/ModQuadricT.hh>
 #include <meshoptimizer.h>
 #include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
@@ -15,6 +16,7 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <numeric>
 #include <optional>
 
@@ -31,7 +33,7 @@ static_assert(sizeof(Vec3f) == 3 * sizeof(float), "meshopt reads positions as pa
 static_assert(sizeof(std::array<std::uint32_t, 3>) == 3 * sizeof(unsigned), "meshopt reads a flat index buffer");
 
 /// meshopt runs per component (the first and its guarded re-runs) before OpenMesh's Decimater takes over.
-constexpr int kMaxRuns = 4;
+constexpr int kMaxRuns = 8;
 
 std::size_t target_face_count(const TriMesh& mesh, const DecimationOptions& o) {
   if (!(o.ratio > 0 && o.ratio <= 1)) throw InvalidInput("decimation: ratio must be in (0, 1], got " + std::to_string(o.ratio));
@@ -94,16 +96,24 @@ class TriangleGrid {
     fill_cells();
   }
 
-  /// Distance from p to the surface, or +inf when it exceeds cap.
-  double distance(const Vec3d& p, double cap) const {
+  struct Hit {
+    double distance2 = std::numeric_limits<double>::infinity();
+    std::uint32_t triangle = ~std::uint32_t(0);
+  };
+
+  /// The nearest triangle to p, or distance2 = +inf when it is farther than cap.
+  Hit nearest(const Vec3d& p, double cap = std::numeric_limits<double>::infinity()) const {
     int c[3];
     for (int a = 0; a < 3; ++a) c[a] = std::clamp(int(std::floor((p[a] - lo_[a]) / h_)), 0, n_[a] - 1);
-    double best2 = std::numeric_limits<double>::infinity();
+    Hit best;
     for (int k = 0;; ++k) {
-      visit_shell(c, k, p, best2);
+      visit_shell(c, k, p, best);
       const double outside = unvisited_distance(c, k, p);
-      if (best2 <= outside * outside) return std::sqrt(best2);
-      if (outside > cap) return std::sqrt(best2) <= cap ? std::sqrt(best2) : std::numeric_limits<double>::infinity();
+      if (best.distance2 <= outside * outside) return best;
+      if (outside > cap) {
+        if (best.distance2 > cap * cap) best.distance2 = std::numeric_limits<double>::infinity();
+        return best;
+      }
     }
   }
 
@@ -134,7 +144,7 @@ class TriangleGrid {
   }
 
   /// Visits the cells at Chebyshev distance exactly k from cell c.
-  void visit_shell(const int c[3], int k, const Vec3d& p, double& best2) const {
+  void visit_shell(const int c[3], int k, const Vec3d& p, Hit& best) const {
     const int z0 = std::max(c[2] - k, 0), z1 = std::min(c[2] + k, n_[2] - 1);
     const int y0 = std::max(c[1] - k, 0), y1 = std::min(c[1] + k, n_[1] - 1);
     const int x0 = std::max(c[0] - k, 0), x1 = std::min(c[0] + k, n_[0] - 1);
@@ -148,7 +158,8 @@ class TriangleGrid {
             const auto& t = surface_.triangles[triangles_[j]];
             const Vec3d q = closest_on_triangle(p, Vec3d(surface_.positions[t[0]]), Vec3d(surface_.positions[t[1]]),
                                                 Vec3d(surface_.positions[t[2]]));
-            best2 = std::min(best2, dot(q - p, q - p));
+            const double d2 = dot(q - p, q - p);
+            if (d2 < best.distance2) best = {d2, triangles_[j]};
           }
         }
       }
@@ -295,7 +306,14 @@ std::size_t freeze_defects(const TriMesh& input, const InputTopology& topo, cons
 std::optional<TriMesh> decimate_with_openmesh(const TriMesh& part, std::size_t target, double max_error,
                                               double max_normal_deviation_deg) {
   std::size_t rejected = 0;
-  detail::OmTriMesh om = detail::to_openmesh(part, &rejected);
+  detail::OmTriMesh om;
+  {
+    // Components run in parallel, but OpenMesh reports refused faces on global streams.
+    static std::mutex streams;
+    const std::lock_guard<std::mutex> lock(streams);
+    const detail::MuteOpenMeshLog mute;
+    om = detail::to_openmesh(part, &rejected);
+  }
   if (rejected > 0) return std::nullopt;
   om.update_face_normals();
   using Decimater = OpenMesh::Decimater::DecimaterT<detail::OmTriMesh>;
@@ -317,6 +335,104 @@ std::optional<TriMesh> decimate_with_openmesh(const TriMesh& part, std::size_t t
   return detail::from_openmesh(om);
 }
 
+/// Area-weighted sum of the plane quadrics (n·x + d)² of input triangles: A = Σ w n nᵀ, b = Σ w n d.
+struct PlaneQuadric {
+  double a[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}, b[3] = {0, 0, 0};
+  void add(const Vec3d& n, double d, double w) {
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) a[i][j] += w * n[i] * n[j];
+      b[i] += w * n[i] * d;
+    }
+  }
+  /// The step from p towards the quadric's minimum, Tikhonov-regularised (λ = 1 % of the mean eigenvalue) so
+  /// directions the planes do not constrain (along a flat or cylindrical patch) stay put.
+  Vec3d step(const Vec3d& p) const {
+    double m[3][3], g[3];
+    const double lambda = 0.01 * (a[0][0] + a[1][1] + a[2][2]) / 3;
+    for (int i = 0; i < 3; ++i) {
+      g[i] = -(a[i][0] * p.x + a[i][1] * p.y + a[i][2] * p.z + b[i]);
+      for (int j = 0; j < 3; ++j) m[i][j] = a[i][j] + (i == j ? lambda : 0);
+    }
+    const auto det3 = [](const double (&r)[3][3]) {
+      return r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1]) - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0]) +
+             r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
+    };
+    const double det = det3(m);
+    if (!(std::abs(det) > 1e-300)) return {};
+    Vec3d x;
+    for (int c = 0; c < 3; ++c) {  // Cramer's rule
+      double mc[3][3];
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) mc[i][j] = j == c ? g[i] : m[i][j];
+      x[c] = det3(mc) / det;
+    }
+    return x;
+  }
+};
+
+Vec3d face_normal(const TriMesh& m, const std::array<std::uint32_t, 3>& t) {
+  const Vec3d p0(m.positions[t[0]]);
+  return cross(Vec3d(m.positions[t[1]]) - p0, Vec3d(m.positions[t[2]]) - p0);
+}
+
+/// Garland-Heckbert placement after the collapses (meshopt and OpenMesh keep an end point, which leaves the
+/// whole sagitta of every chord on one side): each interior output vertex moves to the regularised minimum of
+/// the plane quadrics of the input triangles whose centroids lie nearest to its incident output triangles,
+/// by at most half its shortest edge. Moves that flip an incident triangle are undone.
+void place_vertices(const TriMesh& input, TriMesh& out) {
+  const TriangleGrid grid(out);
+  std::vector<std::uint32_t> nearest(input.triangle_count());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nearest.size(), 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t f = r.begin(); f < r.end(); ++f) {
+      const auto& t = input.triangles[f];
+      const Vec3d c = (Vec3d(input.positions[t[0]]) + Vec3d(input.positions[t[1]]) + Vec3d(input.positions[t[2]])) / 3.0;
+      nearest[f] = grid.nearest(c).triangle;
+    }
+  });
+  std::vector<PlaneQuadric> quadrics(out.vertex_count());
+  for (std::size_t f = 0; f < input.triangle_count(); ++f) {  // serial: a fixed summation order
+    const Vec3d n = face_normal(input, input.triangles[f]);
+    const double len = length(n);
+    if (!(len > 0)) continue;
+    const Vec3d unit = n / len;
+    for (const std::uint32_t v : out.triangles[nearest[f]])
+      quadrics[v].add(unit, -dot(unit, Vec3d(input.positions[input.triangles[f][0]])), 0.5 * len);
+  }
+  std::vector<double> reach(out.vertex_count(), 1e300);
+  for (const auto& t : out.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const double e = 0.5 * length(Vec3d(out.positions[t[k]]) - Vec3d(out.positions[t[(k + 1) % 3]]));
+      reach[t[k]] = std::min(reach[t[k]], e);
+      reach[t[(k + 1) % 3]] = std::min(reach[t[(k + 1) % 3]], e);
+    }
+  const std::vector<VertexKind> kinds = classify_vertices(out);
+  const TriMesh before = out;
+  for (std::size_t v = 0; v < out.vertex_count(); ++v) {
+    if (kinds[v] != VertexKind::Interior) continue;  // borders and non-manifold vertices stay
+    Vec3d d = quadrics[v].step(Vec3d(out.positions[v]));
+    if (length(d) > reach[v]) d = d * (reach[v] / length(d));
+    out.positions[v] = Vec3f(Vec3d(out.positions[v]) + d);
+  }
+  for (bool reverted = true; reverted;) {  // each pass only undoes moves, so this ends
+    reverted = false;
+    for (const auto& t : out.triangles) {
+      if (dot(face_normal(out, t), face_normal(before, t)) > 0) continue;
+      for (const std::uint32_t v : t) {
+        reverted |= out.positions[v] != before.positions[v];
+        out.positions[v] = before.positions[v];
+      }
+    }
+  }
+}
+
+/// place_vertices() unless it would break the max_error bound (checked again: it moves vertices).
+void place_within_bound(const TriMesh& input, TriMesh& out, double max_error) {
+  TriMesh placed = out;
+  place_vertices(input, placed);
+  if (max_error > 0 && !(max_distance_to_surface(input.positions, placed, max_error) <= max_error)) return;
+  out = std::move(placed);
+}
+
 /// The guarded meshopt loop on one connected component: a run that adds a topology defect is redone with the
 /// triangles around each defect frozen, one that breaks max_error with a halved error limit. A result that
 /// changed the Euler characteristic (meshopt pinched a handle and then collapsed the pinch away, which leaves
@@ -331,7 +447,7 @@ TriMesh decimate_component(const TriMesh& part, std::size_t target, const Decima
   std::size_t frozen_count = 0;
   std::unique_ptr<InputTopology> topo;  // built on the first topology failure
   for (int run = 0; run < kMaxRuns; ++run) {
-    if (run > 0) ++stats.retries;
+    ++stats.retries;
     const unsigned flags = before.boundary_edges > 0 || frozen_count > 0 ? unsigned(meshopt_SimplifyLockBorder) : 0u;
     float reached_error = 0;
     const Candidate c = run_meshopt(part, frozen_count > 0 ? split_frozen(part, frozen) : SplitMesh{part, identity(part)},
@@ -352,23 +468,28 @@ TriMesh decimate_component(const TriMesh& part, std::size_t target, const Decima
       continue;
     }
     stats.frozen_faces += frozen_count;
-    return c.mesh;
+    TriMesh result = c.mesh;
+    if (options.optimal_placement) place_within_bound(part, result, options.max_error);
+    return result;
   }
   ++stats.openmesh_components;
   std::optional<TriMesh> fallback =
       decimate_with_openmesh(part, target, options.max_error, options.max_normal_deviation_deg);
-  if (fallback) return std::move(*fallback);
+  if (fallback) {
+    if (options.optimal_placement) place_within_bound(part, *fallback, options.max_error);
+    return std::move(*fallback);
+  }
   stats.frozen_faces += part.triangle_count();
   return part;  // non-manifold input OpenMesh cannot hold: unchanged is the only result known to be safe
 }
 
-/// The connected components of `mesh` as separate compact meshes (vertices in first-use order), in label order.
-std::vector<TriMesh> split_components(const TriMesh& mesh) {
-  const ComponentLabels labels = label_components(mesh);
-  std::vector<TriMesh> parts(labels.count);
+/// Splits `mesh` by a per-triangle label into compact meshes (vertices in first-use order), one per label.
+std::vector<TriMesh> split_by_label(const TriMesh& mesh, const std::vector<std::uint32_t>& face_label,
+                                    std::size_t labels) {
+  std::vector<TriMesh> parts(labels);
   std::vector<std::uint32_t> local(mesh.vertex_count(), ~std::uint32_t(0));
   for (std::size_t f = 0; f < mesh.triangle_count(); ++f) {
-    TriMesh& part = parts[labels.face_component[f]];
+    TriMesh& part = parts[face_label[f]];
     std::array<std::uint32_t, 3> t;
     for (int k = 0; k < 3; ++k) {
       std::uint32_t& id = local[mesh.triangles[f][k]];
@@ -383,6 +504,24 @@ std::vector<TriMesh> split_components(const TriMesh& mesh) {
   return parts;
 }
 
+/// Accepts the global run's proposal for one component if it passes the guard, else redoes the component
+/// alone (decimate_component) towards the face count the global run gave it.
+TriMesh guard_component(const TriMesh& part, const MeshAnalysis& before, TriMesh proposal,
+                        const DecimationOptions& options, DecimationResult& stats) {
+  const MeshAnalysis out = analyze_mesh(proposal);
+  const bool ok = !adds_defects(before, out) && out.euler_characteristic == before.euler_characteristic &&
+                  out.components == before.components &&
+                  (options.max_error == 0 ||
+                   max_distance_to_surface(part.positions, proposal, options.max_error) <= options.max_error);
+  if (ok) {
+    if (options.optimal_placement) place_within_bound(part, proposal, options.max_error);
+    return proposal;
+  }
+  // A closed surface needs at least 4 triangles (a tetrahedron).
+  const std::size_t target = std::max<std::size_t>(4, proposal.triangle_count());
+  return target >= part.triangle_count() ? part : decimate_component(part, target, options, stats);
+}
+
 }  // namespace
 
 double max_distance_to_surface(Span<const Vec3f> points, const TriMesh& surface, double cap) {
@@ -394,7 +533,7 @@ double max_distance_to_surface(Span<const Vec3f> points, const TriMesh& surface,
       tbb::blocked_range<std::size_t>(0, points.size(), 256), 0.0,
       [&](const tbb::blocked_range<std::size_t>& r, double worst) {
         for (std::size_t i = r.begin(); i < r.end() && !exceeded.load(std::memory_order_relaxed); ++i) {
-          worst = std::max(worst, grid.distance(Vec3d(points[i]), cap));
+          worst = std::max(worst, std::sqrt(grid.nearest(Vec3d(points[i]), cap).distance2));
           if (std::isinf(worst)) exceeded = true;
         }
         return exceeded ? std::numeric_limits<double>::infinity() : worst;
@@ -411,27 +550,33 @@ DecimationResult decimate(const TriMesh& mesh, const DecimationOptions& options)
     result.reached_target = true;
     return result;
   }
-  // Components are simplified one by one, smallest first, each towards its share of what is left of the
-  // budget: a small one the guard keeps whole (meshopt tends to collapse it away) then costs the big ones,
-  // not the target.
-  std::vector<TriMesh> parts = split_components(mesh);
-  std::vector<std::size_t> order(parts.size());
-  std::iota(order.begin(), order.end(), std::size_t(0));
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return parts[a].triangle_count() < parts[b].triangle_count(); });
-  std::size_t faces_left = 0, budget = target;
-  for (const TriMesh& p : parts) faces_left += p.triangle_count();
-  std::size_t input_vertices = 0, output_faces = 0;
-  for (const std::size_t i : order) {
-    const std::size_t faces = parts[i].triangle_count();
-    // A closed surface needs at least 4 triangles (a tetrahedron).
-    const std::size_t share = std::max<std::size_t>(
-        4, std::size_t(std::llround(double(budget) * double(faces) / double(faces_left))));
-    input_vertices += parts[i].vertex_count();
-    if (share < faces) parts[i] = decimate_component(parts[i], share, options, result);
-    faces_left -= faces;
-    budget -= std::min(budget, parts[i].triangle_count());
-    output_faces += parts[i].triangle_count();
+  // One global meshopt run spends the face budget where the quadric error is lowest across all components;
+  // the guard then judges each component on its own (they share no vertex), in parallel.
+  const ComponentLabels labels = label_components(mesh);
+  std::vector<TriMesh> parts = split_by_label(mesh, labels.face_component, labels.count);
+  std::vector<MeshAnalysis> before(parts.size());
+  tbb::parallel_for(std::size_t(0), parts.size(), [&](std::size_t i) { before[i] = analyze_mesh(parts[i]); });
+  const bool open = std::any_of(before.begin(), before.end(), [](const MeshAnalysis& a) { return a.boundary_edges > 0; });
+  const float scale = meshopt_simplifyScale(&mesh.positions[0].x, mesh.vertex_count(), sizeof(Vec3f));
+  float reached_error = 0;
+  const Candidate global = run_meshopt(mesh, SplitMesh{mesh, identity(mesh)}, target,
+                                       options.max_error > 0 ? float(options.max_error / double(scale)) : FLT_MAX,
+                                       open ? unsigned(meshopt_SimplifyLockBorder) : 0u, &reached_error);
+  std::vector<std::uint32_t> vertex_component(mesh.vertex_count(), 0), proposal_label;
+  for (std::size_t f = 0; f < mesh.triangle_count(); ++f)
+    for (const std::uint32_t v : mesh.triangles[f]) vertex_component[v] = labels.face_component[f];
+  for (const auto& t : global.mesh.triangles) proposal_label.push_back(vertex_component[global.input_vertex[t[0]]]);
+  std::vector<TriMesh> proposals = split_by_label(global.mesh, proposal_label, labels.count);
+  std::vector<DecimationResult> stats(parts.size());
+  tbb::parallel_for(std::size_t(0), parts.size(), [&](std::size_t i) {
+    parts[i] = guard_component(parts[i], before[i], std::move(proposals[i]), options, stats[i]);
+  });
+  std::size_t input_vertices = 0;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    input_vertices += before[i].vertices;
+    result.retries += stats[i].retries;
+    result.frozen_faces += stats[i].frozen_faces;
+    result.openmesh_components += stats[i].openmesh_components;
   }
   for (const TriMesh& p : parts) {
     const auto base = std::uint32_t(result.mesh.positions.size());
@@ -439,7 +584,7 @@ DecimationResult decimate(const TriMesh& mesh, const DecimationOptions& options)
     for (const auto& t : p.triangles) result.mesh.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
   }
   result.collapses = input_vertices - result.mesh.vertex_count();
-  result.reached_target = output_faces <= target;
+  result.reached_target = result.mesh.triangle_count() <= target;
   return result;
 }
 

@@ -1,12 +1,13 @@
 #pragma once
-/// \file Quadric simplification with meshoptimizer's meshopt_simplify (ALGORITHMS.md §3, docs/isosurface.md).
-/// Why meshoptimizer: it runs edge collapses ordered by Garland-Heckbert quadric error at tens of millions of
-/// triangles per second (OpenMesh's Decimater was 2-2.7x slower than vtkQuadricDecimation) and stops at an
-/// error limit. Its collapses keep one end point (no optimal placement), so output vertices are input vertices.
-/// Its error metric is a quadric estimate: the area-weighted mean squared distance of a kept vertex to the
-/// planes of the triangles merged into it, relative to the mesh extent (meshopt_simplifyScale). It is not a
-/// Hausdorff distance and meshopt has no link-condition check, so decimate() verifies its result (below) and
-/// re-runs meshopt with a halved error limit when a check fails.
+/// \file Quadric simplification: meshoptimizer's meshopt_simplify with a topology guard, OpenMesh's Decimater
+/// as the fallback (ALGORITHMS.md §3, docs/isosurface.md). Why meshoptimizer: edge collapses ordered by
+/// Garland-Heckbert quadric error, bounded by an error limit, 3-7x faster than vtkQuadricDecimation where the
+/// guard has little to redo (OpenMesh's Decimater alone was 2-2.7x slower than VTK). Its error metric is a quadric
+/// estimate relative to the mesh extent (meshopt_simplifyScale): roughly the area-weighted mean squared
+/// distance of a kept vertex to the planes of the triangles merged into it, not a Hausdorff distance; so
+/// max_error is checked exactly afterwards. meshopt 0.18 has no link-condition check: on marching-cubes
+/// output it makes non-manifold edges, closes handles and collapses small components away, so every
+/// component's result is checked (guard below).
 #include <cstddef>
 #include <string>
 
@@ -19,31 +20,40 @@ struct DecimationOptions {
   double ratio = 0.1;            ///< target faces = round(ratio · input faces), in (0, 1]; 1 = no decimation
   std::size_t target_faces = 0;  ///< if > 0, overrides ratio (must be <= input faces)
   /// World units, >= 0; 0 = unbounded. Guaranteed: every input vertex lies within this distance of the output
-  /// surface (one-sided Hausdorff, input vertices -> output triangles, measured exactly after each meshopt
-  /// run; a run that exceeds it is redone with a smaller meshopt error limit). The target may then not be
-  /// reached.
+  /// surface (one-sided Hausdorff, input vertices -> output triangles, measured exactly; a meshopt run that
+  /// exceeds it is redone with a halved error limit, OpenMesh's fallback uses ModHausdorff, a vertex placement
+  /// that exceeds it is dropped). The target may then not be reached.
   double max_error = 0;
-  /// Accepted for source compatibility; meshopt refuses collapses that flip a triangle normal by more
-  /// than 90 degrees and has no finer setting, so only the range (0, 180] is checked.
+  /// Move kept interior vertices to their (regularised) quadric minimum afterwards: meshopt and OpenMesh keep an
+  /// end point of each collapse, so output vertices are input vertices and chords cut inside convex parts.
+  /// Borders and non-manifold vertices never move; false keeps every output vertex an input vertex.
+  bool optimal_placement = true;
+  /// For the OpenMesh fallback (ModNormalFlipping); meshopt has only its own fixed flip test.
   double max_normal_deviation_deg = 45.0;
 };
 
 struct DecimationResult {
-  TriMesh mesh;  ///< only used vertices, numbered in first-use order (no isolated vertices)
+  /// Only used vertices, per component in first-use order (no isolated vertices); the input itself when the
+  /// target is not below the input's face count.
+  TriMesh mesh;
   std::size_t collapses = 0;  ///< vertices removed (one per edge collapse)
-  /// Faces <= target + 1 (a collapse removes two faces of a closed mesh). meshopt stops a pass once its
-  /// budget is met, so an unconstrained run lands on the target or one below. False when the error bound
-  /// or the topology guard stopped it earlier.
+  /// Faces <= target. Where the guard does not intervene on a closed 2-manifold, the count is the target or
+  /// one below (a collapse removes two faces, meshopt stops once the budget is met). A component the guard
+  /// redoes keeps the face count the first run gave it, and may land a few below it, or above it when
+  /// frozen triangles, the error bound or OpenMesh's normal test stop it early (then false).
   bool reached_target = false;
   int retries = 0;  ///< meshopt re-runs after a failed check (topology defect or max_error), all components
   std::size_t frozen_faces = 0;  ///< input triangles the topology guard kept unsimplified
   std::size_t openmesh_components = 0;  ///< components meshopt could not simplify safely (OpenMesh fallback)
 };
 
-/// Simplifies `mesh` towards the face target. Borders are locked when the mesh has boundary edges, so open
-/// surfaces keep their outline exactly. Topology guard: the result has the input's Euler characteristic,
-/// component count, boundary edges and no more non-manifold edges/vertices or inconsistently oriented edges
-/// than the input (so a closed 2-manifold stays one, with the same genus). Serial, deterministic.
+/// Simplifies `mesh` towards the face target: one meshopt run over the whole mesh (borders locked when it has
+/// boundary edges, so open surfaces keep their outline exactly), then the guard per connected component:
+/// its result must keep the component's Euler characteristic, stay one component, keep its boundary edges
+/// and add no non-manifold edge/vertex or inconsistent edge (a closed 2-manifold stays one, same genus). A
+/// failing component is redone alone: up to 8 meshopt runs, each freezing the input triangles within k rings
+/// of the defects of run k; then OpenMesh's Decimater (link condition); then unchanged. Deterministic for any
+/// thread count (components are guarded in parallel).
 /// \throw InvalidInput for out-of-range options or a mesh failing validate_mesh().
 DecimationResult decimate(const TriMesh& mesh, const DecimationOptions& options = {});
 
