@@ -6,7 +6,10 @@
 #include <memory>
 #include <sstream>
 
+#include <cmath>
+
 #include "apps/raysift/command.h"
+#include "apps/raysift/run_program.h"
 #include "core/file_util.h"
 #include "core/scene.h"
 #include "isosurface/feature_geometry.h"
@@ -19,6 +22,7 @@ namespace {
 struct SweepOptions {
   std::string scene, out, plot;
   std::string fractions = "0.1,0.2,0.4,0.7";
+  std::string budgets_ms, time_fractions, steps, early_terminations;
   std::string features = "contours,silhouettes";
   std::string alpha;
   std::string feature_mesh;
@@ -27,49 +31,30 @@ struct SweepOptions {
   int repeats = 1;
 };
 
-std::vector<double> parse_fractions(const std::string& text) {
+/// A comma-separated list of numbers each satisfying `ok`; exit 2 naming the first bad entry.
+template <typename Ok>
+std::vector<double> parse_list(const std::string& flag, const std::string& text, const std::string& expected, Ok ok) {
   std::vector<double> out;
   std::stringstream s(text);
   std::string item;
   while (std::getline(s, item, ',')) {
     char* end = nullptr;
     const double v = std::strtod(item.c_str(), &end);
-    if (item.empty() || *end != '\0' || !(v > 0 && v <= 1))
-      bad_flag("--ray-fractions", "comma-separated fractions in (0, 1]", text);
+    if (item.empty() || *end != '\0' || !ok(v)) bad_flag(flag, expected + " (bad entry '" + item + "')", text);
     out.push_back(v);
   }
-  if (out.empty()) bad_flag("--ray-fractions", "comma-separated fractions in (0, 1]", text);
+  if (out.empty()) bad_flag(flag, expected, text);
   return out;
 }
 
-// Error against ray fraction and against frame time, one line per mode (matplotlib, Debian's python3).
-constexpr const char* kPlotScript = R"PY(
-import csv, sys
-import matplotlib
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
-rows = list(csv.DictReader(open(sys.argv[1])))
-full = [r for r in rows if r["mode"] == "full"][0]
-fig, axes = plt.subplots(2, 2, figsize=(11, 8))
-for mode, style in (("prioritized", "o-"), ("control", "s--"), ("subsample", "^:")):
-    rs = [r for r in rows if r["mode"] == mode]
-    if not rs: continue
-    f = [float(r["ray_fraction"]) for r in rs]
-    t = [float(r["total_ms"]) for r in rs]
-    flip = [float(r["flip_object"]) for r in rs]
-    dssim = [1 - float(r["ssim_object"]) for r in rs]
-    axes[0][0].plot(f, flip, style, label=mode); axes[0][1].plot(t, flip, style, label=mode)
-    axes[1][0].plot(f, dssim, style, label=mode); axes[1][1].plot(t, dssim, style, label=mode)
-for ax in [a for row in axes for a in row]:
-    ax.grid(True, alpha=0.3); ax.legend()
-for ax in axes[0]: ax.set_ylabel("FLIP (object pixels)")
-for ax in axes[1]: ax.set_ylabel("1 - SSIM (object pixels)")
-axes[1][0].set_xlabel("ray fraction"); axes[1][1].set_xlabel("frame time (ms)")
-for ax in (axes[0][1], axes[1][1]):
-    ax.axvline(float(full["total_ms"]), color="gray", lw=1); ax.text(float(full["total_ms"]), ax.get_ylim()[1], " full", va="top")
-fig.suptitle(sys.argv[3])
-fig.tight_layout(); fig.savefig(sys.argv[2], dpi=110)
-)PY";
+std::vector<double> optional_list(const std::string& flag, const std::string& text, const std::string& expected,
+                                  bool (*ok)(double)) {
+  return text.empty() ? std::vector<double>{} : parse_list(flag, text, expected, ok);
+}
+
+bool is_fraction(double v) { return v > 0 && v <= 1; }
+bool is_positive(double v) { return v > 0 && std::isfinite(v); }
+bool is_step(double v) { return v > 0 && v <= 64; }
 
 void write_text(const std::string& path, const std::string& text) {
   write_atomically(path, [&](const std::string& tmp) {
@@ -79,16 +64,13 @@ void write_text(const std::string& path, const std::string& text) {
   });
 }
 
+/// Runs scripts/plot_trade.py with an argument vector (no shell, so no quoting of paths).
 void write_plot(const std::string& csv_path, const std::string& png_path, const std::string& title) {
-  const std::string script_path = png_path + ".plot.py";
-  write_text(script_path, kPlotScript);
-  const std::string command = "/usr/bin/python3 '" + script_path + "' '" + csv_path + "' '" + png_path + "' '" +
-                              title + "' 2>&1";
-  const int rc = std::system(command.c_str());
-  std::remove(script_path.c_str());
+  const std::string script = std::string(RAYSIFT_SOURCE_DIR) + "/scripts/plot_trade.py";
+  const int rc = run_program({"/usr/bin/python3", script, csv_path, png_path, title});
   if (rc != 0)
-    throw IoError(file_message(png_path, "plotting failed (needs /usr/bin/python3 with matplotlib: apt-get install "
-                                         "python3-matplotlib); the CSV was written"));
+    throw IoError(file_message(png_path, "plotting failed (" + script + " needs /usr/bin/python3 with matplotlib: "
+                                         "apt-get install python3-matplotlib); the CSV was written"));
 }
 
 /// The feature geometry fitted to the sweep's view and importance resolution.
@@ -105,7 +87,13 @@ RegisterCommand reg(
       sub.add_option("SCENE", opt->scene, "scene JSON (volume, transfer_function, camera)")->required();
       sub.add_option("-o,--out", opt->out, "CSV output, one row per (mode, fraction)")->required();
       sub.add_option("--ray-fractions", opt->fractions, "comma-separated fractions in (0, 1]")->capture_default_str();
-      sub.add_option("--plot", opt->plot, "also draw error vs fraction and vs time per mode (PNG)");
+      sub.add_option("--budgets-ms", opt->budgets_ms, "also prioritized and control rows at these frame budgets (ms)");
+      sub.add_option("--time-fractions", opt->time_fractions,
+                     "also prioritized and control rows at these fractions of the full frame time, (0, 1]");
+      sub.add_option("--steps", opt->steps, "also full renders at these sampling steps (voxels, (0, 64])");
+      sub.add_option("--early-termination", opt->early_terminations,
+                     "also full renders at these early-termination opacities, (0, 1]");
+      sub.add_option("--plot", opt->plot, "also draw error vs frame time for every mode and knob (PNG)");
       sub.add_option("--features", opt->features, "line classes of the prioritized rows")->capture_default_str();
       sub.add_option("--alpha", opt->alpha, "priority mapping a00,a10,a01,a11,a20,a02 (default 0.5,0.5,0.5,0.5,0,0; recommended 0.5,0.1,0.5,0.1,0,0)");
       sub.add_option("--feature-mesh", opt->feature_mesh, "prepared feature mesh instead of the iso-surfaces");
@@ -117,13 +105,21 @@ RegisterCommand reg(
           "Example:\n  raysift sweep datasets/engine_ct_scene.json --ray-fractions 0.1,0.2,0.4,0.7 -o trade.csv "
           "--plot trade.png");
       return [opt, &common] {
-        const std::vector<double> fractions = parse_fractions(opt->fractions);
+        const std::vector<double> fractions =
+            parse_list("--ray-fractions", opt->fractions, "comma-separated fractions in (0, 1]", is_fraction);
+        const std::vector<double> steps =
+            optional_list("--steps", opt->steps, "comma-separated steps in (0, 64] voxels", is_step);
+        const std::vector<double> early_terminations = optional_list(
+            "--early-termination", opt->early_terminations, "comma-separated opacities in (0, 1]", is_fraction);
         if (opt->repeats < 1) bad_flag("--repeats", ">= 1", std::to_string(opt->repeats));
         if (opt->shading != "none" && opt->shading != "phong") bad_flag("--shading", "none|phong", opt->shading);
         if (file_extension(opt->out) != ".csv") bad_flag("-o/--out", "a .csv path", opt->out);
         if (!opt->plot.empty() && file_extension(opt->plot) != ".png") bad_flag("--plot", "a .png path", opt->plot);
         sampling::TradeOptions trade;
         trade.ray_fractions = fractions;
+        trade.budgets_ms = optional_list("--budgets-ms", opt->budgets_ms, "comma-separated budgets > 0 ms", is_positive);
+        trade.time_fractions =
+            optional_list("--time-fractions", opt->time_fractions, "comma-separated fractions in (0, 1]", is_fraction);
         trade.repeats = opt->repeats;
         trade.sampling.seed = common.seed;
         try {
@@ -151,8 +147,11 @@ RegisterCommand reg(
         if (!trade.features.classes.is_empty())
           geometry = opt->feature_mesh.empty() ? isosurface::build_feature_geometry(vol, tf, feature_options(camera, trade))
                                                : isosurface::load_feature_geometry(opt->feature_mesh, &vol);
-        const sampling::TradeResult result =
+        sampling::TradeResult result =
             sampling::run_trade(caster, trade.features.classes.is_empty() ? nullptr : &geometry, trade);
+        const std::vector<sampling::TradeRow> knobs =
+            sampling::run_render_knobs(vol, tf, camera, render, steps, early_terminations, result, trade);
+        result.rows.insert(result.rows.end(), knobs.begin(), knobs.end());
         const std::string csv = sampling::trade_csv(result.rows);
         write_text(opt->out, csv);
         if (!common.quiet) std::cout << csv;

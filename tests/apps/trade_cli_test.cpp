@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "core/image.h"
@@ -77,7 +78,7 @@ TEST(SweepCli, WritesOneRowPerModeAndFractionWithTheDocumentedHeader) {
   std::getline(in, header);
   EXPECT_EQ(header,
             "mode,ray_fraction,rays_traced,importance_ms,trace_ms,reconstruct_ms,total_ms,psnr,ssim,ssim_object,mae,"
-            "flip,flip_object");
+            "flip,flip_object,budget_ms,step,early_termination");
   std::vector<std::string> modes;
   std::string line;
   while (std::getline(in, line))
@@ -92,6 +93,72 @@ TEST(SweepCli, WritesOneRowPerModeAndFractionWithTheDocumentedHeader) {
   const CliRun bad = raysift(dir, "sweep scene.json --ray-fractions 0,1.5 -o bad.csv");
   EXPECT_EQ(bad.code, 2) << bad.err;
   EXPECT_FALSE(fs::exists(dir + "/bad.csv"));
+}
+
+/// Rows of a sweep CSV as column name -> value.
+std::vector<std::map<std::string, std::string>> read_rows(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> names;
+  std::stringstream header(line);
+  for (std::string n; std::getline(header, n, ',');) names.push_back(n);
+  std::vector<std::map<std::string, std::string>> rows;
+  while (std::getline(in, line)) {
+    std::stringstream s(line);
+    std::map<std::string, std::string> row;
+    std::string v;
+    for (const std::string& n : names) std::getline(s, v, ','), row[n] = v;
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+TEST(SweepCli, BudgetStepAndEarlyTerminationRowsAndTheirBadEntries) {
+  const std::string dir = test::make_temp_dir("sweep_cli_knobs");
+  ASSERT_EQ(raysift(dir, "make-volume ball --dims 24,24,24 --radius 9 --quiet -o ball.vdb").code, 0);
+  write_json_file(dir + "/scene.json", Json::parse(R"({
+      "volume": "ball.vdb",
+      "transfer_function": {"points": [[0, 1, 0.6, 0.2, 0], [0.45, 1, 0.6, 0.2, 0], [0.55, 1, 0.6, 0.2, 0.3], [1, 1, 0.6, 0.2, 0.3]]},
+      "camera": {"eye": [40, 30, 60], "target": [12, 12, 12], "up": [0, 1, 0], "fov_y_deg": 40, "width": 48, "height": 32}})"));
+  const CliRun r = raysift(dir, "sweep scene.json --ray-fractions 0.5 --budgets-ms 1000 --time-fractions 0.5 "
+                                "--steps 0.25,2 --early-termination 0.5 --shading none -o trade.csv");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto rows = read_rows(dir + "/trade.csv");
+  ASSERT_EQ(rows.size(), 1u + 3u + 2u * 2u + 3u);  // full, 3 modes at 0.5, 2 modes x 2 budgets, 3 knob renders
+  int budgeted = 0, steps = 0, early = 0;
+  for (const auto& row : rows) {
+    if (std::stod(row.at("budget_ms")) > 0) {
+      ++budgeted;
+      EXPECT_TRUE(row.at("mode") == "prioritized" || row.at("mode") == "control") << row.at("mode");
+    }
+    if (row.at("mode") == "full" && row.at("step") != "0.5") ++steps;
+    if (row.at("mode") == "full" && row.at("early_termination") == "0.5") ++early;
+  }
+  EXPECT_EQ(budgeted, 4);
+  EXPECT_EQ(steps, 2);
+  EXPECT_EQ(early, 1);
+  // A 1000 ms budget on a 48x32 frame is never exhausted: every object ray is traced.
+  for (const auto& row : rows) {
+    if (row.at("budget_ms") == "1000.000") {
+      EXPECT_EQ(row.at("ray_fraction"), "1.0000") << row.at("mode");
+    }
+  }
+  // A coarser step changes the image, so its row must score below the reference.
+  for (const auto& row : rows) {
+    if (row.at("mode") == "full" && row.at("step") == "2") {
+      EXPECT_LT(std::stod(row.at("ssim_object")), 1.0);
+    }
+  }
+
+  for (const char* flags : {"--budgets-ms 10,-3", "--budgets-ms 10,abc", "--time-fractions 0", "--steps 0",
+                                   "--early-termination 1.5"}) {
+    const CliRun bad = raysift(dir, std::string("sweep scene.json ") + flags + " -o bad.csv");
+    EXPECT_EQ(bad.code, 2) << flags << ": " << bad.err;
+    EXPECT_FALSE(fs::exists(dir + "/bad.csv")) << flags;
+  }
+  const CliRun named = raysift(dir, "sweep scene.json --budgets-ms 10,abc -o bad.csv");
+  EXPECT_NE(named.err.find("'abc'"), std::string::npos) << named.err;
 }
 
 }  // namespace
