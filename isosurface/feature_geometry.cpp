@@ -42,7 +42,8 @@ std::string options_fingerprint(const FeatureGeometryOptions& o, int coarsening,
   s << "feature-geometry v1;iso=";
   for (const double v : o.iso_values) s << v << ',';
   s << ";max_surfaces=" << o.max_surfaces << ";smooth=" << o.smooth_iterations << ";ratio=" << o.decimate_ratio
-    << ";coarsening=" << coarsening << ";max_error=" << max_error << ";drop_hidden=" << o.drop_hidden;
+    << ";coarsening=" << coarsening << ";max_error=" << max_error << ";drop_hidden=" << o.drop_hidden
+    << ";simplifier=meshopt-unguarded-unplaced";
   return s.str();
 }
 
@@ -53,6 +54,10 @@ PipelineOptions pipeline_options(const FeatureGeometryOptions& o, double max_err
   p.prep.smooth_before.iterations = p.prep.smooth_after.iterations = o.smooth_iterations;
   p.prep.decimation.ratio = o.decimate_ratio;
   p.prep.decimation.max_error = max_error;
+  // Lines need positions, not a guaranteed manifold: meshopt alone, vertices kept where meshopt leaves them
+  // (optimal placement cost 5x the simplification itself on the engine CT for sub-pixel gains).
+  p.prep.decimation.keep_topology = false;
+  p.prep.decimation.optimal_placement = false;
   p.cancel = o.cancel;
   p.progress = o.progress;
   return p;
@@ -136,7 +141,9 @@ FeatureGeometry build_feature_geometry(const volume::Volume& volume, const volum
     }
   }
   if (!geometry.from_cache) {
+    Timer stage;
     const volume::Volume level = volume::downsample(volume, geometry.coarsening);
+    geometry.level_ms = stage.elapsed_ms();
     FeatureGeometryOptions chosen = options;
     if (chosen.iso_values.empty()) {  // chosen on the full-resolution histogram, so every level agrees
       volume::IsoValueOptions iso_options;
@@ -144,8 +151,11 @@ FeatureGeometry build_feature_geometry(const volume::Volume& volume, const volum
       for (const volume::IsoValue& v : volume::select_iso_values(volume, tf, iso_options))
         chosen.iso_values.push_back(v.value);
     }
+    stage.reset();
     if (options.drop_hidden) split_hidden(volume, level, geometry.coarsening, tf, chosen.iso_values, geometry.hidden_iso_values);
+    geometry.probe_ms = stage.elapsed_ms();
     const IsosurfaceSet set = build_isosurfaces(level, &tf, pipeline_options(chosen, max_error));
+    geometry.stages = set.stages;
     geometry.mesh = merge_surfaces(set);
     geometry.iso_values = chosen.iso_values;
     if (geometry.mesh.triangles.empty())
@@ -153,7 +163,9 @@ FeatureGeometry build_feature_geometry(const volume::Volume& volume, const volum
                          "data range");
     if (cache) cache->store(*key, {geometry.iso_values, geometry.mesh});
   }
+  const Timer curvature;
   geometry.curvature = mesh::compute_curvature(geometry.mesh);
+  geometry.curvature_ms = curvature.elapsed_ms();
   geometry.build_ms = timer.elapsed_ms();
   return geometry;
 }

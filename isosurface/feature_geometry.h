@@ -27,6 +27,10 @@ struct FeatureGeometry {
   int coarsening = 1;              ///< grid level used: cells of this many voxels per axis
   bool from_cache = false;
   double build_ms = 0;             ///< wall time of the whole set-up (cache look-up included)
+  /// Where the set-up went (ms; zero on a cache hit): coarse level, visibility probe, pipeline stages
+  /// (summed over surfaces), curvature.
+  double level_ms = 0, probe_ms = 0, curvature_ms = 0;
+  StageTimes stages;
 };
 
 /// The view the geometry is made for: the frame camera and the importance buffer's size relative to it.
@@ -42,9 +46,9 @@ struct FeatureGeometryOptions {
   double decimate_ratio = 0.1;     ///< target faces / input faces, in (0,1] (1 = off)
   /// Grid level: 0 = chosen from `view` (1 without a view); else 1, 2, 4 or 8 voxels per cell.
   int coarsening = 0;
-  double cell_px = 1.0;            ///< automatic level: the coarsest whose cells project to <= this many importance px
+  double cell_px = 2.0;            ///< automatic level: the coarsest whose cells project to <= this many importance px
   /// > 0 and a view: simplification also stops once its error would exceed this many importance pixels.
-  double max_error_px = 0.5;
+  double max_error_px = 1.0;
   /// Drop iso-surfaces that the TF hides from every direction (volume/iso_visibility.h), e.g. inside opaque
   /// material; if the probe finds none visible, all are kept.
   bool drop_hidden = true;

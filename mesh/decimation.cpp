@@ -541,6 +541,21 @@ double max_distance_to_surface(Span<const Vec3f> points, const TriMesh& surface,
       [](double a, double b) { return std::max(a, b); });
 }
 
+/// keep_topology = false: one meshopt run (borders locked, a no-op on closed meshes), optional placement.
+DecimationResult unguarded(const TriMesh& mesh, std::size_t target, const DecimationOptions& options) {
+  const float scale = meshopt_simplifyScale(&mesh.positions[0].x, mesh.vertex_count(), sizeof(Vec3f));
+  float reached_error = 0;
+  Candidate c = run_meshopt(mesh, SplitMesh{mesh, identity(mesh)}, target,
+                            options.max_error > 0 ? float(options.max_error / double(scale)) : FLT_MAX,
+                            unsigned(meshopt_SimplifyLockBorder), &reached_error);
+  if (options.optimal_placement) place_vertices(mesh, c.mesh);
+  DecimationResult result;
+  result.collapses = mesh.vertex_count() - c.mesh.vertex_count();
+  result.reached_target = c.mesh.triangle_count() <= target;
+  result.mesh = std::move(c.mesh);
+  return result;
+}
+
 DecimationResult decimate(const TriMesh& mesh, const DecimationOptions& options) {
   validate_mesh(mesh, "decimation");
   const std::size_t target = target_face_count(mesh, options);
@@ -550,6 +565,7 @@ DecimationResult decimate(const TriMesh& mesh, const DecimationOptions& options)
     result.reached_target = true;
     return result;
   }
+  if (!options.keep_topology) return unguarded(mesh, target, options);
   // One global meshopt run spends the face budget where the quadric error is lowest across all components;
   // the guard then judges each component on its own (they share no vertex), in parallel.
   const ComponentLabels labels = label_components(mesh);

@@ -28,6 +28,10 @@ struct DecimationOptions {
   /// end point of each collapse, so output vertices are input vertices and chords cut inside convex parts.
   /// Borders and non-manifold vertices never move; false keeps every output vertex an input vertex.
   bool optimal_placement = true;
+  /// false: one meshopt run without the topology guard below (it may add non-manifold edges and close
+  /// handles), max_error then only as meshopt's own error limit. For geometry whose use needs positions and
+  /// not topology (the feature lines): about as fast as meshopt alone.
+  bool keep_topology = true;
   /// For the OpenMesh fallback (ModNormalFlipping); meshopt has only its own fixed flip test.
   double max_normal_deviation_deg = 45.0;
 };

@@ -106,6 +106,11 @@ SampledRender render_sampled_volume(const volume::Volume& volume, const volume::
     stats["iso_values"] = geometry.iso_values;
     stats["feature_coarsening"] = geometry.coarsening;
     stats["hidden_iso_values"] = geometry.hidden_iso_values;
+    const isosurface::StageTimes& t = geometry.stages;
+    stats["features_setup_ms"] = {{"level", geometry.level_ms},         {"probe", geometry.probe_ms},
+                                  {"iso_choice", t.iso_choice_ms},       {"marching_cubes", t.marching_cubes.ms},
+                                  {"smooth_before", t.smooth_before.ms}, {"decimate", t.decimate.ms},
+                                  {"smooth_after", t.smooth_after.ms},   {"curvature", geometry.curvature_ms}};
     stats["feature_cache_hit"] = geometry.from_cache;
   }
   auto fill = [&](const SampledFrame& f, double importance_ms, double total_ms, std::uint64_t samples) {
