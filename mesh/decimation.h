@@ -1,7 +1,7 @@
 #pragma once
 /// \file Quadric simplification: meshoptimizer's meshopt_simplify with a topology guard, OpenMesh's Decimater
 /// as the fallback (ALGORITHMS.md §3, docs/isosurface.md). Why meshoptimizer: edge collapses ordered by
-/// Garland-Heckbert quadric error, bounded by an error limit, 3-7x faster than vtkQuadricDecimation where the
+/// Garland-Heckbert quadric error, bounded by an error limit, 4-11x faster than vtkQuadricDecimation where the
 /// guard has little to redo (OpenMesh's Decimater alone was 2-2.7x slower than VTK). Its error metric is a quadric
 /// estimate relative to the mesh extent (meshopt_simplifyScale): roughly the area-weighted mean squared
 /// distance of a kept vertex to the planes of the triangles merged into it, not a Hausdorff distance; so
