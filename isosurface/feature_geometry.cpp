@@ -43,7 +43,7 @@ std::string options_fingerprint(const FeatureGeometryOptions& o, int coarsening,
   for (const double v : o.iso_values) s << v << ',';
   s << ";max_surfaces=" << o.max_surfaces << ";smooth=" << o.smooth_iterations << ";ratio=" << o.decimate_ratio
     << ";coarsening=" << coarsening << ";max_error=" << max_error << ";drop_hidden=" << o.drop_hidden
-    << ";simplifier=meshopt-unguarded-unplaced";
+    << ";simplifier=meshopt-unguarded";
   return s.str();
 }
 
@@ -54,10 +54,9 @@ PipelineOptions pipeline_options(const FeatureGeometryOptions& o, double max_err
   p.prep.smooth_before.iterations = p.prep.smooth_after.iterations = o.smooth_iterations;
   p.prep.decimation.ratio = o.decimate_ratio;
   p.prep.decimation.max_error = max_error;
-  // Lines need positions, not a guaranteed manifold: meshopt alone, vertices kept where meshopt leaves them
-  // (optimal placement cost 5x the simplification itself on the engine CT for sub-pixel gains).
+  // Lines need positions, not a guaranteed manifold: meshopt alone (the topology guard cost 5-20x the
+  // simplification itself on the engine CT and the MRI).
   p.prep.decimation.keep_topology = false;
-  p.prep.decimation.optimal_placement = false;
   p.cancel = o.cancel;
   p.progress = o.progress;
   return p;

@@ -335,104 +335,6 @@ std::optional<TriMesh> decimate_with_openmesh(const TriMesh& part, std::size_t t
   return detail::from_openmesh(om);
 }
 
-/// Area-weighted sum of the plane quadrics (n·x + d)² of input triangles: A = Σ w n nᵀ, b = Σ w n d.
-struct PlaneQuadric {
-  double a[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}, b[3] = {0, 0, 0};
-  void add(const Vec3d& n, double d, double w) {
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) a[i][j] += w * n[i] * n[j];
-      b[i] += w * n[i] * d;
-    }
-  }
-  /// The step from p towards the quadric's minimum, Tikhonov-regularised (λ = 1 % of the mean eigenvalue) so
-  /// directions the planes do not constrain (along a flat or cylindrical patch) stay put.
-  Vec3d step(const Vec3d& p) const {
-    double m[3][3], g[3];
-    const double lambda = 0.01 * (a[0][0] + a[1][1] + a[2][2]) / 3;
-    for (int i = 0; i < 3; ++i) {
-      g[i] = -(a[i][0] * p.x + a[i][1] * p.y + a[i][2] * p.z + b[i]);
-      for (int j = 0; j < 3; ++j) m[i][j] = a[i][j] + (i == j ? lambda : 0);
-    }
-    const auto det3 = [](const double (&r)[3][3]) {
-      return r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1]) - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0]) +
-             r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
-    };
-    const double det = det3(m);
-    if (!(std::abs(det) > 1e-300)) return {};
-    Vec3d x;
-    for (int c = 0; c < 3; ++c) {  // Cramer's rule
-      double mc[3][3];
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) mc[i][j] = j == c ? g[i] : m[i][j];
-      x[c] = det3(mc) / det;
-    }
-    return x;
-  }
-};
-
-Vec3d face_normal(const TriMesh& m, const std::array<std::uint32_t, 3>& t) {
-  const Vec3d p0(m.positions[t[0]]);
-  return cross(Vec3d(m.positions[t[1]]) - p0, Vec3d(m.positions[t[2]]) - p0);
-}
-
-/// Garland-Heckbert placement after the collapses (meshopt and OpenMesh keep an end point, which leaves the
-/// whole sagitta of every chord on one side): each interior output vertex moves to the regularised minimum of
-/// the plane quadrics of the input triangles whose centroids lie nearest to its incident output triangles,
-/// by at most half its shortest edge. Moves that flip an incident triangle are undone.
-void place_vertices(const TriMesh& input, TriMesh& out) {
-  const TriangleGrid grid(out);
-  std::vector<std::uint32_t> nearest(input.triangle_count());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nearest.size(), 1024), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t f = r.begin(); f < r.end(); ++f) {
-      const auto& t = input.triangles[f];
-      const Vec3d c = (Vec3d(input.positions[t[0]]) + Vec3d(input.positions[t[1]]) + Vec3d(input.positions[t[2]])) / 3.0;
-      nearest[f] = grid.nearest(c).triangle;
-    }
-  });
-  std::vector<PlaneQuadric> quadrics(out.vertex_count());
-  for (std::size_t f = 0; f < input.triangle_count(); ++f) {  // serial: a fixed summation order
-    const Vec3d n = face_normal(input, input.triangles[f]);
-    const double len = length(n);
-    if (!(len > 0)) continue;
-    const Vec3d unit = n / len;
-    for (const std::uint32_t v : out.triangles[nearest[f]])
-      quadrics[v].add(unit, -dot(unit, Vec3d(input.positions[input.triangles[f][0]])), 0.5 * len);
-  }
-  std::vector<double> reach(out.vertex_count(), 1e300);
-  for (const auto& t : out.triangles)
-    for (int k = 0; k < 3; ++k) {
-      const double e = 0.5 * length(Vec3d(out.positions[t[k]]) - Vec3d(out.positions[t[(k + 1) % 3]]));
-      reach[t[k]] = std::min(reach[t[k]], e);
-      reach[t[(k + 1) % 3]] = std::min(reach[t[(k + 1) % 3]], e);
-    }
-  const std::vector<VertexKind> kinds = classify_vertices(out);
-  const TriMesh before = out;
-  for (std::size_t v = 0; v < out.vertex_count(); ++v) {
-    if (kinds[v] != VertexKind::Interior) continue;  // borders and non-manifold vertices stay
-    Vec3d d = quadrics[v].step(Vec3d(out.positions[v]));
-    if (length(d) > reach[v]) d = d * (reach[v] / length(d));
-    out.positions[v] = Vec3f(Vec3d(out.positions[v]) + d);
-  }
-  for (bool reverted = true; reverted;) {  // each pass only undoes moves, so this ends
-    reverted = false;
-    for (const auto& t : out.triangles) {
-      if (dot(face_normal(out, t), face_normal(before, t)) > 0) continue;
-      for (const std::uint32_t v : t) {
-        reverted |= out.positions[v] != before.positions[v];
-        out.positions[v] = before.positions[v];
-      }
-    }
-  }
-}
-
-/// place_vertices() unless it would break the max_error bound (checked again: it moves vertices).
-void place_within_bound(const TriMesh& input, TriMesh& out, double max_error) {
-  TriMesh placed = out;
-  place_vertices(input, placed);
-  if (max_error > 0 && !(max_distance_to_surface(input.positions, placed, max_error) <= max_error)) return;
-  out = std::move(placed);
-}
-
 /// The guarded meshopt loop on one connected component: a run that adds a topology defect is redone with the
 /// triangles around each defect frozen, one that breaks max_error with a halved error limit. A result that
 /// changed the Euler characteristic (meshopt pinched a handle and then collapsed the pinch away, which leaves
@@ -468,17 +370,12 @@ TriMesh decimate_component(const TriMesh& part, std::size_t target, const Decima
       continue;
     }
     stats.frozen_faces += frozen_count;
-    TriMesh result = c.mesh;
-    if (options.optimal_placement) place_within_bound(part, result, options.max_error);
-    return result;
+    return c.mesh;
   }
   ++stats.openmesh_components;
   std::optional<TriMesh> fallback =
       decimate_with_openmesh(part, target, options.max_error, options.max_normal_deviation_deg);
-  if (fallback) {
-    if (options.optimal_placement) place_within_bound(part, *fallback, options.max_error);
-    return std::move(*fallback);
-  }
+  if (fallback) return std::move(*fallback);
   stats.frozen_faces += part.triangle_count();
   return part;  // non-manifold input OpenMesh cannot hold: unchanged is the only result known to be safe
 }
@@ -513,10 +410,7 @@ TriMesh guard_component(const TriMesh& part, const MeshAnalysis& before, TriMesh
                   out.components == before.components &&
                   (options.max_error == 0 ||
                    max_distance_to_surface(part.positions, proposal, options.max_error) <= options.max_error);
-  if (ok) {
-    if (options.optimal_placement) place_within_bound(part, proposal, options.max_error);
-    return proposal;
-  }
+  if (ok) return proposal;
   // A closed surface needs at least 4 triangles (a tetrahedron).
   const std::size_t target = std::max<std::size_t>(4, proposal.triangle_count());
   return target >= part.triangle_count() ? part : decimate_component(part, target, options, stats);
@@ -541,14 +435,13 @@ double max_distance_to_surface(Span<const Vec3f> points, const TriMesh& surface,
       [](double a, double b) { return std::max(a, b); });
 }
 
-/// keep_topology = false: one meshopt run (borders locked, a no-op on closed meshes), optional placement.
+/// keep_topology = false: one meshopt run (borders locked, a no-op on closed meshes).
 DecimationResult unguarded(const TriMesh& mesh, std::size_t target, const DecimationOptions& options) {
   const float scale = meshopt_simplifyScale(&mesh.positions[0].x, mesh.vertex_count(), sizeof(Vec3f));
   float reached_error = 0;
   Candidate c = run_meshopt(mesh, SplitMesh{mesh, identity(mesh)}, target,
                             options.max_error > 0 ? float(options.max_error / double(scale)) : FLT_MAX,
                             unsigned(meshopt_SimplifyLockBorder), &reached_error);
-  if (options.optimal_placement) place_vertices(mesh, c.mesh);
   DecimationResult result;
   result.collapses = mesh.vertex_count() - c.mesh.vertex_count();
   result.reached_target = c.mesh.triangle_count() <= target;

@@ -1,11 +1,12 @@
 #pragma once
 /// \file Quadric simplification: meshoptimizer's meshopt_simplify with a topology guard, OpenMesh's Decimater
 /// as the fallback (ALGORITHMS.md §3, docs/isosurface.md). Why meshoptimizer: edge collapses ordered by
-/// Garland-Heckbert quadric error, bounded by an error limit, 3-7x faster than vtkQuadricDecimation where the
+/// Garland-Heckbert quadric error, bounded by an error limit, 4-11x faster than vtkQuadricDecimation where the
 /// guard has little to redo (OpenMesh's Decimater alone was 2-2.7x slower than VTK). Its error metric is a quadric
 /// estimate relative to the mesh extent (meshopt_simplifyScale): roughly the area-weighted mean squared
 /// distance of a kept vertex to the planes of the triangles merged into it, not a Hausdorff distance; so
-/// max_error is checked exactly afterwards. meshopt 0.18 has no link-condition check: on marching-cubes
+/// max_error is checked exactly afterwards. Both libraries keep an end point of each collapse: output vertices
+/// are input vertices. meshopt 0.18 has no link-condition check: on marching-cubes
 /// output it makes non-manifold edges, closes handles and collapses small components away, so every
 /// component's result is checked (guard below).
 #include <cstddef>
@@ -21,13 +22,9 @@ struct DecimationOptions {
   std::size_t target_faces = 0;  ///< if > 0, overrides ratio (must be <= input faces)
   /// World units, >= 0; 0 = unbounded. Guaranteed: every input vertex lies within this distance of the output
   /// surface (one-sided Hausdorff, input vertices -> output triangles, measured exactly; a meshopt run that
-  /// exceeds it is redone with a halved error limit, OpenMesh's fallback uses ModHausdorff, a vertex placement
-  /// that exceeds it is dropped). The target may then not be reached.
+  /// exceeds it is redone with a halved error limit, OpenMesh's fallback uses ModHausdorff). The target may
+  /// then not be reached.
   double max_error = 0;
-  /// Move kept interior vertices to their (regularised) quadric minimum afterwards: meshopt and OpenMesh keep an
-  /// end point of each collapse, so output vertices are input vertices and chords cut inside convex parts.
-  /// Borders and non-manifold vertices never move; false keeps every output vertex an input vertex.
-  bool optimal_placement = true;
   /// false: one meshopt run without the topology guard below (it may add non-manifold edges and close
   /// handles), max_error then only as meshopt's own error limit. For geometry whose use needs positions and
   /// not topology (the feature lines): about as fast as meshopt alone.
