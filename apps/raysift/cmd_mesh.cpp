@@ -32,6 +32,7 @@ struct MeshCliOptions {
   long long faces = 0;
   double max_error = 0;
   bool flip = false;
+  bool unguarded = false;
 };
 
 std::vector<double> parse_iso_list(const std::string& text) {
@@ -114,6 +115,7 @@ isosurface::PipelineOptions pipeline_options(const MeshCliOptions& o) {
   }
   p.prep.decimation.ratio = o.decimate;
   p.prep.decimation.max_error = o.max_error;
+  p.prep.decimation.keep_topology = !o.unguarded;
   p.total_target_faces = std::size_t(o.faces);
   return p;
 }
@@ -200,6 +202,9 @@ RegisterCommand reg(
       sub.add_option("--max-error", opt->max_error,
                      "decimation distance bound in world units (0 = unbounded)")->capture_default_str();
       sub.add_flag("--flip", opt->flip, "normals toward increasing values (default: toward decreasing)");
+      sub.add_flag("--unguarded", opt->unguarded,
+                   "simplify without the topology guard: several times faster on noisy surfaces, but the result may "
+                   "have non-manifold edges and closed handles");
       sub.footer(
           "Examples:\n"
           "  raysift mesh engine.vdb --tf engine_tf.json -o engine.ply --stats mesh_stats.json\n"

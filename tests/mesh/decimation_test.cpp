@@ -280,3 +280,23 @@ TEST(Decimation, BadInputThrows) {
 
 }  // namespace
 }  // namespace raysift::mesh
+
+namespace raysift::mesh {
+namespace {
+
+TEST(Decimation, UnguardedRunReachesTheTargetWithInputVerticesOnly) {
+  const TriMesh sphere = make_icosphere(1.0, 5);  // 20480 faces
+  DecimationOptions o;
+  o.target_faces = 2000;
+  o.keep_topology = false;
+  const DecimationResult r = decimate(sphere, o);
+  EXPECT_TRUE(r.reached_target);
+  EXPECT_LE(r.mesh.triangle_count(), 2000u);
+  EXPECT_GE(r.mesh.triangle_count(), 1990u);
+  EXPECT_EQ(analyze_mesh(r.mesh).isolated_vertices, 0u);
+  for (const Vec3f& p : r.mesh.positions) ASSERT_NEAR(length(Vec3d(p)), 1.0, 1e-6);  // kept input vertices
+  EXPECT_EQ(decimate(sphere, o).mesh.triangles, r.mesh.triangles);  // deterministic
+}
+
+}  // namespace
+}  // namespace raysift::mesh
