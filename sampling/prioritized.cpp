@@ -58,6 +58,53 @@ std::size_t ray_target(const SamplingOptions& options, std::size_t object, std::
   return std::min(object, std::max(level0, wanted));
 }
 
+
+double reconstruct_reserve(const SamplingOptions& options, int w, int h) {
+  return options.reconstruct_reserve_ms >= 0 ? options.reconstruct_reserve_ms
+                                             : estimate_reconstruct_ms(w, h, options.base_spacing);
+}
+
+// Budget mode with the a priori bucketed queue (RP paper section 5).
+void trace_budgeted_queue(const ImageF& importance, const FractalPattern& pattern, const SamplingOptions& options,
+                          const TraceBatch& trace, const ElapsedMs& now, double elapsed_before_ms,
+                          SampledFrame& frame, Timer& stage) {
+  const RayQueue queue = make_bucketed_queue(importance, pattern, options.mapping, options.buckets, options.seed);
+  frame.priorities_ms = stage.elapsed_ms();
+  const double reserve = reconstruct_reserve(options, importance.width, importance.height);
+  stage.reset();
+  const Span<const std::uint32_t> all(queue.pixels.data(), queue.pixels.size());
+  trace_all(Span<const std::uint32_t>(all.data(), queue.level0_count), trace, frame.image);
+  const double deadline = options.budget_ms - elapsed_before_ms - reserve;
+  frame.budget_too_small = now() > deadline;
+  const std::size_t more = trace_until(
+      Span<const std::uint32_t>(all.data() + queue.level0_count, all.size() - queue.level0_count), trace,
+      frame.image, now, deadline);
+  frame.rays_traced = queue.level0_count + more;
+  frame.trace_ms = stage.elapsed_ms();
+  mark(Span<const std::uint32_t>(queue.pixels.data(), frame.rays_traced), frame.traced);
+}
+
+// Fraction or budget mode with a posteriori refinement; the priorities are computed inside the trace rounds
+// and counted as trace time.
+void trace_refined_frame(const ImageF& importance, const FractalPattern& pattern, const SamplingOptions& options,
+                         const TraceBatch& trace, std::size_t target, const ElapsedMs& now,
+                         double elapsed_before_ms, SampledFrame& frame, Timer& stage) {
+  RefinementStop stop;
+  stop.rays = target;
+  if (options.budget_ms > 0) {
+    stop.deadline_ms = options.budget_ms - elapsed_before_ms - reconstruct_reserve(options, importance.width,
+                                                                                  importance.height);
+    stop.now = &now;
+  }
+  frame.priorities_ms = stage.elapsed_ms();
+  stage.reset();
+  const RefinementResult r =
+      trace_refined(importance, pattern, options.refinement, stop, options.seed, trace, frame.image, frame.traced);
+  frame.trace_ms = stage.elapsed_ms();
+  frame.rays_traced = r.rays;
+  frame.budget_too_small = r.level0_overran;
+}
+
 }  // namespace
 
 SamplingMode parse_sampling_mode(const std::string& name) {
@@ -143,25 +190,13 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
     return frame;
   }
 
-  RayQueue queue;
-  if (options.budget_ms > 0) {
-    queue = make_bucketed_queue(importance, pattern, options.mapping, options.buckets, options.seed);
-    frame.priorities_ms = stage.elapsed_ms();
-    const double reserve = options.reconstruct_reserve_ms >= 0 ? options.reconstruct_reserve_ms
-                                                                : estimate_reconstruct_ms(w, h, options.base_spacing);
-    stage.reset();
-    const Span<const std::uint32_t> all(queue.pixels.data(), queue.pixels.size());
-    trace_all(Span<const std::uint32_t>(all.data(), queue.level0_count), trace, frame.image);
-    const double deadline = options.budget_ms - elapsed_before_ms - reserve;
-    frame.budget_too_small = now() > deadline;
-    const std::size_t more = trace_until(Span<const std::uint32_t>(all.data() + queue.level0_count,
-                                                                   all.size() - queue.level0_count),
-                                         trace, frame.image, now, deadline);
-    frame.rays_traced = queue.level0_count + more;
-    frame.trace_ms = stage.elapsed_ms();
-    mark(Span<const std::uint32_t>(queue.pixels.data(), frame.rays_traced), frame.traced);
+  if (options.refinement.enabled && !std::isfinite(options.threshold)) {
+    trace_refined_frame(importance, pattern, options, trace, target, now, elapsed_before_ms, frame, stage);
+  } else if (options.budget_ms > 0) {
+    trace_budgeted_queue(importance, pattern, options, trace, now, elapsed_before_ms, frame, stage);
   } else {
-    queue = select_top_rays(importance, pattern, options.mapping, target, options.seed, options.threshold);
+    const RayQueue queue =
+        select_top_rays(importance, pattern, options.mapping, target, options.seed, options.threshold);
     ImageMask selected(w, h, 0);
     mark(queue.pixels, selected);
     trace_selection(selected, trace, frame, stage);

@@ -12,6 +12,7 @@
 #include "sampling/fractal_pattern.h"
 #include "sampling/image_mask.h"
 #include "sampling/ray_order.h"
+#include "sampling/refinement.h"
 #include "sampling/scheduler.h"
 
 namespace raysift::sampling {
@@ -34,7 +35,9 @@ struct SamplingOptions {
   double budget_ms = 0;
   /// Budget mode: time kept for reconstruction (ms); < 0 = measured on a calibration crop.
   double reconstruct_reserve_ms = -1;
-  PriorityMapping mapping;
+  PriorityMapping mapping;  ///< the a priori queue (refinement off, threshold and progressive modes)
+  /// Prioritized fraction and budget modes: place rays from the traced level-0 samples (refinement.h).
+  RefinementOptions refinement;
   int base_spacing = 8;   ///< fractal level-0 spacing, px (power of two)
   int buckets = 256;      ///< priority buckets of the budget/progressive queue
   std::uint64_t seed = 1;
