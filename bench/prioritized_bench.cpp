@@ -9,7 +9,7 @@
 //  * budget mode p95 / budget on the engine CT.
 // Scenes: engine CT opaque and translucent (second view), MRI head opaque and translucent, and with --unseen
 // the smoke VDB from /work/shared/datasets with a TF written once (normalised to its value range) and never tuned.
-// Usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--floor F] [--line-weight W]
+// Usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--linear] [--floor F] [--line-weight W]
 //                          [--alpha a00,...,a02] [--budget-frames N]
 #include <algorithm>
 #include <cmath>
@@ -65,6 +65,8 @@ struct Error {
 struct TimedError {
   double ms = 0;
   Error error;
+  std::size_t rays = 0;
+  double trace_ms = 0, reconstruct_ms = 0;
 };
 
 Error error_of(const ImageRGBA& full, const ImageRGBA& image) {
@@ -124,12 +126,13 @@ TimedError sampled_frame(const volume::RayCaster& caster, const ImageF& importan
   const sampling::SampledFrame f = sampling::render_sampled(importance, sampling::caster_trace_batch(caster), s,
                                                             importance_ms);
   const ImageRGBA image = sampling::composite_frame(f.image, caster.options().background);
-  return {importance_ms + t.elapsed_ms(), error_of(full, image)};
+  return {importance_ms + t.elapsed_ms(), error_of(full, image), f.rays_traced, f.trace_ms, f.reconstruct_ms};
 }
 
 void print_ratio_row(const char* what, double share, const TimedError& m, const Error& sub, double full_ms) {
-  std::printf("  %-26s %3.0f%%  %7.0f ms (%4.2f)  %6.3f  %6.3f  %6.3f\n", what, share * 100, m.ms, m.ms / full_ms,
-              m.error.flip / sub.flip, m.error.dssim / sub.dssim, m.error.dssim_linear / sub.dssim_linear);
+  std::printf("  %-26s %3.0f%%  %7.0f ms (%4.2f)  %6.3f  %6.3f  %6.3f   [%zu rays, trace %.0f ms, reconstruct %.0f ms]\n",
+              what, share * 100, m.ms, m.ms / full_ms, m.error.flip / sub.flip, m.error.dssim / sub.dssim,
+              m.error.dssim_linear / sub.dssim_linear, m.rays, m.trace_ms, m.reconstruct_ms);
 }
 
 void run_scene(const Scene& sc, const Setup& setup, int width, int height, bool budget_table) {
@@ -152,6 +155,19 @@ void run_scene(const Scene& sc, const Setup& setup, int width, int height, bool 
               sc.label.c_str(), full_ms, lines_ms, 100 * lines_ms / full_ms, bg_ms, geometry.mesh.triangles.size(),
               geometry.build_ms);
 
+  // Each mode's own cost without the rays: the same frame with a tracer that returns at once.
+  const sampling::TraceBatch no_trace = [](Span<const std::uint32_t>, Span<Rgba> out) {
+    for (Rgba& c : out) c = Rgba{0.5f, 0.5f, 0.5f, 1.0f};
+  };
+  for (double f : {0.1, 0.4}) {
+    sampling::SamplingOptions s = setup.sampling;
+    s.ray_fraction = f;
+    const double p_ms = min_ms(3, [&] { sampling::render_sampled(lines, no_trace, s); });
+    s.mode = sampling::SamplingMode::Subsample;
+    const double s_ms = min_ms(3, [&] { sampling::render_sampled(background, no_trace, s); });
+    std::printf("overhead without rays at fraction %.1f: prioritized %.1f ms, subsample %.1f ms\n", f, p_ms, s_ms);
+  }
+
   std::vector<TimedError> curve;
   std::printf("subsample curve: fraction ms (x full) FLIP_obj 1-SSIM_obj 1-SSIMlin_obj\n");
   for (double f : {0.03, 0.05, 0.075, 0.1, 0.15, 0.2, 0.3, 0.4, 0.55, 0.7}) {
@@ -164,8 +180,9 @@ void run_scene(const Scene& sc, const Setup& setup, int width, int height, bool 
       if (e.ms < best.ms) best = e;
     }
     curve.push_back(best);
-    std::printf("  %.3f %7.0f (%4.2f) %.4f %.4f %.4f\n", f, best.ms, best.ms / full_ms, best.error.flip,
-                best.error.dssim, best.error.dssim_linear);
+    std::printf("  %.3f %7.0f (%4.2f) %.4f %.4f %.4f  [%zu rays, trace %.0f ms, reconstruct %.0f ms]\n", f, best.ms,
+                best.ms / full_ms, best.error.flip, best.error.dssim, best.error.dssim_linear, best.rays, best.trace_ms,
+                best.reconstruct_ms);
   }
 
   std::printf("equal time: mode, budget (share of full), frame ms (x full), ratio to subsample at that time:"
@@ -185,12 +202,13 @@ void run_scene(const Scene& sc, const Setup& setup, int width, int height, bool 
   for (std::size_t k : {3u, 5u, 7u}) {  // fractions 0.1, 0.2, 0.4 of the curve
     sampling::SamplingOptions s = setup.sampling;
     s.ray_fraction = k == 3 ? 0.1 : k == 5 ? 0.2 : 0.4;
-    const Error p = sampled_frame(caster, lines, lines_ms, s, full).error;
-    const Error c = sampled_frame(caster, control, bg_ms, s, full).error;
-    const Error& sub = curve[k].error;
-    std::printf("  %.1f  %6.3f %6.3f %6.3f   %6.3f %6.3f %6.3f\n", s.ray_fraction, p.flip / sub.flip,
-                p.dssim / sub.dssim, p.dssim_linear / sub.dssim_linear, c.flip / sub.flip, c.dssim / sub.dssim,
-                c.dssim_linear / sub.dssim_linear);
+    const TimedError pt = sampled_frame(caster, lines, 0.05 * full_ms, s, full);
+    const TimedError ct = sampled_frame(caster, control, bg_ms, s, full);
+    const Error &p = pt.error, &c = ct.error, &sub = curve[k].error;
+    std::printf("  %.1f  %6.3f %6.3f %6.3f   %6.3f %6.3f %6.3f   [prioritized (imp. at 5%%) %.0f ms, trace %.0f ms; "
+                "control %.0f ms, trace %.0f ms]\n", s.ray_fraction, p.flip / sub.flip, p.dssim / sub.dssim,
+                p.dssim_linear / sub.dssim_linear, c.flip / sub.flip, c.dssim / sub.dssim,
+                c.dssim_linear / sub.dssim_linear, pt.ms, pt.trace_ms, ct.ms, ct.trace_ms);
   }
 
   if (!budget_table || setup.budget_frames < 1) return;
@@ -237,13 +255,14 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--quick")) quick = true;
     else if (!std::strcmp(argv[i], "--unseen")) unseen = true;
     else if (!std::strcmp(argv[i], "--no-refine")) setup.sampling.refinement.enabled = false;
+    else if (!std::strcmp(argv[i], "--linear")) setup.sampling.interpolation = sampling::Interpolation::Linear;
     else if (!std::strcmp(argv[i], "--floor") && more) setup.sampling.refinement.floor = std::stof(argv[++i]);
     else if (!std::strcmp(argv[i], "--line-weight") && more) setup.sampling.refinement.line_weight = std::stof(argv[++i]);
     else if (!std::strcmp(argv[i], "--scenes") && more) scenes = argv[++i];
     else if (!std::strcmp(argv[i], "--alpha") && more) setup.sampling.mapping = sampling::parse_priority_mapping(argv[++i]);
     else if (!std::strcmp(argv[i], "--budget-frames") && more) setup.budget_frames = std::atoi(argv[++i]);
     else {
-      std::fprintf(stderr, "usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--floor F] "
+      std::fprintf(stderr, "usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--linear] [--floor F] "
                            "[--line-weight W] [--alpha a00,...,a02] [--budget-frames N]\n");
       return 2;
     }
@@ -251,8 +270,10 @@ int main(int argc, char** argv) {
   setup.features.classes = sampling::parse_feature_list("contours,silhouettes");
   const int width = quick ? 720 : 1440, height = quick ? 450 : 900;
   const auto& a = setup.sampling.mapping.alpha;
-  std::printf("prioritized_bench: %dx%d, phong, contours+silhouettes, refinement %s (floor %g, line weight %g), "
-              "alpha %g,%g,%g,%g,%g,%g\n", width, height, setup.sampling.refinement.enabled ? "on" : "off",
+  std::printf("prioritized_bench: %dx%d, phong, contours+silhouettes, %s reconstruction, refinement %s (floor %g, "
+              "line weight %g), alpha %g,%g,%g,%g,%g,%g\n", width, height,
+              setup.sampling.interpolation == sampling::Interpolation::Cubic ? "cubic" : "linear",
+              setup.sampling.refinement.enabled ? "on" : "off",
               setup.sampling.refinement.floor, setup.sampling.refinement.line_weight, a[0], a[1], a[2], a[3], a[4],
               a[5]);
   const std::string dir = std::string(RAYSIFT_SOURCE_DIR) + "/datasets/";

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <mutex>
 
 #include "core/errors.h"
 #include "sampling/reconstruction.h"
@@ -51,6 +53,18 @@ void trace_selection(const ImageMask& selected, const TraceBatch& trace, Sampled
   frame.trace_ms = stage.elapsed_ms();
   mark(rays, frame.traced);
   frame.rays_traced = rays.size();
+}
+
+// The counts without building the pattern (the subsample and full modes do not need it).
+ObjectCounts count_object_pixels(const ImageF& importance, int spacing) {
+  ObjectCounts c;
+  for (int y = 0; y < importance.height; ++y)
+    for (int x = 0; x < importance.width; ++x) {
+      if (importance(x, y) < 0) continue;
+      ++c.object;
+      c.level0 += x % spacing == 0 && y % spacing == 0 ? 1 : 0;
+    }
+  return c;
 }
 
 std::size_t ray_target(const SamplingOptions& options, std::size_t object, std::size_t level0) {
@@ -143,14 +157,22 @@ ImageF control_importance(const ImageF& importance) {
 }
 
 double estimate_reconstruct_ms(int width, int height, int base_spacing) {
-  const int cw = std::min(width, 512), ch = std::min(height, 512);
-  const FractalPattern pattern = make_fractal_pattern(cw, ch, base_spacing);
-  ImageMask known(cw, ch, 0);
-  for (std::size_t i = 0; i < known.size(); ++i) known.pixels[i] = pattern.level.pixels[i] == 0 ? 1 : 0;
-  ImageRGBA image(cw, ch);
-  const Timer timer;
-  reconstruct_fractal(image, known, pattern);
-  return timer.elapsed_ms() * double(width) * double(height) / (double(cw) * double(ch));
+  // Measured once per (crop, spacing) and process: the estimate must not cost a reconstruction per frame.
+  static std::mutex mutex;
+  static std::map<std::pair<int, int>, double> ms_per_pixel;  // key (crop side, spacing)
+  const int side = std::min(256, std::max(16, std::min(width, height)));
+  std::lock_guard<std::mutex> lock(mutex);
+  auto it = ms_per_pixel.find({side, base_spacing});
+  if (it == ms_per_pixel.end()) {
+    const FractalPattern pattern = make_fractal_pattern(side, side, base_spacing);
+    ImageMask known(side, side, 0);
+    for (std::size_t i = 0; i < known.size(); ++i) known.pixels[i] = pattern.level.pixels[i] == 0 ? 1 : 0;
+    ImageRGBA image(side, side);
+    const Timer timer;
+    reconstruct_fractal(image, known, pattern);
+    it = ms_per_pixel.emplace(std::make_pair(side, base_spacing), timer.elapsed_ms() / double(side * side)).first;
+  }
+  return it->second * double(width) * double(height);
 }
 
 SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, const SamplingOptions& options,
@@ -165,8 +187,7 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
   frame.traced = ImageMask(w, h, 0);
 
   Timer stage;
-  const FractalPattern pattern = make_fractal_pattern(w, h, options.base_spacing);
-  const ObjectCounts counts = count_object_pixels(importance, pattern);
+  const ObjectCounts counts = count_object_pixels(importance, options.base_spacing);
   frame.full_rays = counts.object;
   frame.level0_rays = counts.level0;
   const std::size_t target = ray_target(options, counts.object, counts.level0);
@@ -190,6 +211,7 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
     return frame;
   }
 
+  const FractalPattern pattern = make_fractal_pattern(w, h, options.base_spacing);
   if (options.refinement.enabled && !std::isfinite(options.threshold)) {
     trace_refined_frame(importance, pattern, options, trace, target, now, elapsed_before_ms, frame, stage);
   } else if (options.budget_ms > 0) {
@@ -206,7 +228,7 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
   if (frame.rays_traced < counts.object) {
     ImageMask known = background_known(importance);
     for (std::size_t i = 0; i < known.size(); ++i) known.pixels[i] |= frame.traced.pixels[i];
-    reconstruct_fractal(frame.image, known, pattern);
+    reconstruct_fractal(frame.image, known, pattern, options.interpolation);
   }
   frame.reconstruct_ms = stage.elapsed_ms();
   return frame;
@@ -265,7 +287,7 @@ SampledFrame ProgressiveSampler::next_frame(const TraceBatch& trace) {
   frame.rays_traced = next_;
   stage.reset();
   frame.image = samples_;
-  if (!converged()) reconstruct_fractal(frame.image, known_, pattern_);
+  if (!converged()) reconstruct_fractal(frame.image, known_, pattern_, options_.interpolation);
   frame.reconstruct_ms = stage.elapsed_ms();
   last_reconstruct_ms_ = frame.reconstruct_ms;
   return frame;

@@ -38,6 +38,8 @@ struct SamplingOptions {
   PriorityMapping mapping;  ///< the a priori queue (refinement off, threshold and progressive modes)
   /// Prioritized fraction and budget modes: place rays from the traced level-0 samples (refinement.h).
   RefinementOptions refinement;
+  /// How the prioritized modes fill untraced pixels (reconstruction.h).
+  Interpolation interpolation = Interpolation::Cubic;
   int base_spacing = 8;   ///< fractal level-0 spacing, px (power of two)
   int buckets = 256;      ///< priority buckets of the budget/progressive queue
   std::uint64_t seed = 1;
@@ -73,7 +75,7 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
                             double elapsed_before_ms = 0);
 
 /// \brief Wall time of one fractal reconstruction of a frame of this size with only level 0 traced
-/// (the worst case), measured on a crop of at most 512x512 and scaled by area.
+/// (the worst case), measured once per process on a crop of at most 256x256 and scaled by area.
 double estimate_reconstruct_ms(int width, int height, int base_spacing);
 
 /// \brief Progressive refinement for a static camera (RP paper section 5): each frame continues the

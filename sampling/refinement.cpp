@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstring>
-#include <queue>
 #include <vector>
 
 #include "core/errors.h"
@@ -17,17 +15,38 @@ namespace {
 // Below this a round's parallel trace does not amortise its start-up; above it the priorities react late.
 constexpr std::size_t kMinRound = 2048;
 
-struct Candidate {
-  std::uint64_t key;  // orderable priority (high 32 bits) | tie-break hash
-  std::uint32_t pixel;
-  bool operator<(const Candidate& o) const { return key < o.key; }
-};
+// Priorities are kept in log-spaced buckets (kBucketsPerOctave per factor 2) instead of a heap: O(1) per
+// candidate, and first-in first-out inside a bucket, which is deterministic because candidates are offered
+// serially in a fixed order.
+constexpr int kBucketsPerOctave = 16, kBuckets = 24 * kBucketsPerOctave;
 
-std::uint32_t orderable(float v) {
-  std::uint32_t u;
-  std::memcpy(&u, &v, sizeof u);
-  return (u & 0x80000000u) ? ~u : (u | 0x80000000u);
+int bucket_of(float priority) {
+  const int b = int(std::floor(-std::log2(std::max(priority, 1e-30f)) * float(kBucketsPerOctave)));
+  return std::min(kBuckets - 1, std::max(0, b + 2 * kBucketsPerOctave));  // priorities up to 4 get bucket >= 0
 }
+
+class BucketQueue {
+ public:
+  BucketQueue() : buckets_(kBuckets) {}
+  void push(float priority, std::uint32_t pixel) {
+    const int b = bucket_of(priority);
+    buckets_[b].push_back(pixel);
+    top_ = std::min(top_, b);
+    ++size_;
+  }
+  std::uint32_t pop() {
+    while (next_[top_] == buckets_[top_].size()) ++top_;
+    --size_;
+    return buckets_[top_][next_[top_]++];
+  }
+  std::size_t size() const { return size_; }
+
+ private:
+  std::vector<std::vector<std::uint32_t>> buckets_;
+  std::array<std::size_t, kBuckets> next_{};
+  int top_ = kBuckets - 1;
+  std::size_t size_ = 0;
+};
 
 // Offsets from a pixel of `level` >= 1 to its parents, and (negated) from a parent to its children there.
 std::array<std::array<int, 2>, 4> parent_offsets(int level, int spacing) {
@@ -39,18 +58,25 @@ std::array<std::array<int, 2>, 4> parent_offsets(int level, int spacing) {
 class Refiner {
  public:
   Refiner(const ImageF& importance, const FractalPattern& pattern, const RefinementOptions& options,
-          std::uint64_t seed, ImageRGBA& image, ImageMask& traced)
-      : imp_(importance), pattern_(pattern), options_(options), seed_(seed), image_(image), traced_(traced),
+          ImageRGBA& image, ImageMask& traced)
+      : imp_(importance), pattern_(pattern), options_(options), image_(image), traced_(traced),
         queued_(importance.width, importance.height, 0) {}
 
   bool known(int x, int y) const { return imp_(x, y) < 0 || traced_(x, y); }
 
-  // Every candidate whose parents are known before any refinement (level 1, and pixels whose parents are
-  // background or outside the image, which no traced parent would ever offer).
-  void offer_initial() {
+  // Candidates no traced parent will offer: every in-image parent is background.
+  void offer_orphans() {
     for (int y = 0; y < imp_.height; ++y)
-      for (int x = 0; x < imp_.width; ++x)
-        if (pattern_.level(x, y) != 0) offer(x, y);
+      for (int x = 0; x < imp_.width; ++x) {
+        const int level = pattern_.level(x, y);
+        if (level == 0 || imp_(x, y) < 0) continue;
+        bool orphan = true;
+        for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
+          const int px = x + o[0], py = y + o[1];
+          orphan = orphan && (px < 0 || py < 0 || px >= imp_.width || py >= imp_.height || imp_(px, py) < 0);
+        }
+        if (orphan) offer(x, y);
+      }
   }
 
   // After `pixel` was traced: the children it may have completed, at every finer level.
@@ -65,15 +91,12 @@ class Refiner {
 
   std::vector<std::uint32_t> pop(std::size_t count) {
     std::vector<std::uint32_t> batch;
-    batch.reserve(std::min(count, heap_.size()));
-    while (batch.size() < count && !heap_.empty()) {
-      batch.push_back(heap_.top().pixel);
-      heap_.pop();
-    }
+    batch.reserve(std::min(count, queue_.size()));
+    while (batch.size() < count && queue_.size() > 0) batch.push_back(queue_.pop());
     return batch;
   }
 
-  std::size_t waiting() const { return heap_.size(); }
+  std::size_t waiting() const { return queue_.size(); }
 
  private:
   void offer(int x, int y) {
@@ -95,20 +118,29 @@ class Refiner {
     float contrast = 0;
     for (int k = 0; k < 4; ++k) contrast = std::max(contrast, hi[k] - lo[k]);
     const float priority = (contrast + options_.floor + options_.line_weight * imp_(x, y)) * std::ldexp(1.0f, -level);
-    const auto pixel = std::uint32_t(y) * std::uint32_t(imp_.width) + std::uint32_t(x);
-    heap_.push({std::uint64_t(orderable(priority)) << 32 | pixel_hash(pixel, seed_), pixel});
+    queue_.push(priority, std::uint32_t(y) * std::uint32_t(imp_.width) + std::uint32_t(x));
     queued_(x, y) = 1;
   }
 
   const ImageF& imp_;
   const FractalPattern& pattern_;
   const RefinementOptions& options_;
-  std::uint64_t seed_;
   ImageRGBA& image_;
   ImageMask& traced_;
   ImageMask queued_;
-  std::priority_queue<Candidate> heap_;
+  BucketQueue queue_;
 };
+
+// A budgeted round in 16x16 tiles (neighbouring rays share volume blocks), the tiles in a hashed order, so the
+// prefix the deadline leaves is spread over the frame rather than its top rows.
+void in_hashed_tile_order(std::vector<std::uint32_t>& batch, int width, std::uint64_t seed) {
+  auto key = [width, seed](std::uint32_t p) {
+    const std::uint32_t x = p % std::uint32_t(width), y = p / std::uint32_t(width);
+    const std::uint32_t tile = (y / 16) * 4096u + x / 16;
+    return std::uint64_t(pixel_hash(tile, seed)) << 32 | p;
+  };
+  std::sort(batch.begin(), batch.end(), [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
+}
 
 // Rays to launch in the next round: a quarter of what is left, so late rounds see the early rounds' samples.
 std::size_t round_size(const RefinementStop& stop, std::size_t done, double rays_per_ms) {
@@ -146,14 +178,16 @@ RefinementResult trace_refined(const ImageF& importance, const FractalPattern& p
   result.level0_overran = stop.now && (*stop.now)() > stop.deadline_ms;
   double rays_per_ms = double(level0.size()) / level0_ms;
 
-  Refiner refiner(importance, pattern, options, seed, image, traced);
-  refiner.offer_initial();
+  Refiner refiner(importance, pattern, options, image, traced);
+  refiner.offer_orphans();
+  for (std::uint32_t p : level0) refiner.offer_children(p);
   while (refiner.waiting() > 0) {
     const std::size_t want = round_size(stop, result.rays, rays_per_ms);
     if (want == 0) break;
     std::vector<std::uint32_t> batch = refiner.pop(want);
     const std::size_t popped = batch.size();
     if (stop.now) {
+      in_hashed_tile_order(batch, w, seed);
       const double start = clock();
       batch.resize(trace_until(batch, trace, image, *stop.now, stop.deadline_ms));
       rays_per_ms = std::max(rays_per_ms * 0.25, double(batch.size()) / std::max(1e-3, clock() - start));
