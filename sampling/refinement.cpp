@@ -13,7 +13,7 @@ namespace raysift::sampling {
 namespace {
 
 // Below this a round's parallel trace does not amortise its start-up; above it the priorities react late.
-constexpr std::size_t kMinRound = 2048;
+constexpr std::size_t kMinRound = 256;
 
 // Priorities are kept in log-spaced buckets (kBucketsPerOctave per factor 2) instead of a heap: O(1) per
 // candidate, and first-in first-out inside a bucket, which is deterministic because candidates are offered
@@ -27,23 +27,41 @@ int bucket_of(float priority) {
 
 class BucketQueue {
  public:
-  BucketQueue() : buckets_(kBuckets) {}
+  explicit BucketQueue(std::uint64_t seed) : buckets_(kBuckets), seed_(seed) {}
   void push(float priority, std::uint32_t pixel) {
     const int b = bucket_of(priority);
     buckets_[b].push_back(pixel);
     top_ = std::min(top_, b);
     ++size_;
   }
-  std::uint32_t pop() {
-    while (next_[top_] == buckets_[top_].size()) ++top_;
-    --size_;
-    return buckets_[top_][next_[top_]++];
+  // Up to `count` pixels, highest buckets first. A bucket's waiting pixels are served in hashed order,
+  // not in the (scan) order they were offered in, so a bucket cut short is spread over the frame.
+  std::vector<std::uint32_t> pop(std::size_t count) {
+    std::vector<std::uint32_t> out;
+    out.reserve(std::min(count, size_));
+    while (out.size() < count && size_ > 0) {
+      std::vector<std::uint32_t>& bucket = buckets_[top_];
+      std::size_t& next = next_[top_];
+      if (next == bucket.size()) {
+        ++top_;
+        continue;
+      }
+      const auto hash = [this](std::uint32_t p) { return std::uint64_t(pixel_hash(p, seed_)) << 32 | p; };
+      std::sort(bucket.begin() + std::ptrdiff_t(next), bucket.end(),
+                [&](std::uint32_t a, std::uint32_t b) { return hash(a) < hash(b); });
+      const std::size_t take = std::min(count - out.size(), bucket.size() - next);
+      out.insert(out.end(), bucket.begin() + std::ptrdiff_t(next), bucket.begin() + std::ptrdiff_t(next + take));
+      next += take;
+      size_ -= take;
+    }
+    return out;
   }
   std::size_t size() const { return size_; }
 
  private:
   std::vector<std::vector<std::uint32_t>> buckets_;
   std::array<std::size_t, kBuckets> next_{};
+  std::uint64_t seed_;
   int top_ = kBuckets - 1;
   std::size_t size_ = 0;
 };
@@ -58,9 +76,10 @@ std::array<std::array<int, 2>, 4> parent_offsets(int level, int spacing) {
 class Refiner {
  public:
   Refiner(const ImageF& importance, const FractalPattern& pattern, const RefinementOptions& options,
-          ImageRGBA& image, ImageMask& traced)
+          std::uint64_t seed, ImageRGBA& image, ImageMask& traced)
       : imp_(importance), pattern_(pattern), options_(options), image_(image), traced_(traced),
-        queued_(importance.width, importance.height, 0) {}
+        taken_(importance.width, importance.height, 0), offered_(importance.width, importance.height, 0.0f),
+        queue_(seed) {}
 
   bool known(int x, int y) const { return imp_(x, y) < 0 || traced_(x, y); }
 
@@ -89,10 +108,15 @@ class Refiner {
       }
   }
 
+  // The best `count` waiting candidates; stale entries (a pixel re-offered at a higher priority, or taken) skipped.
   std::vector<std::uint32_t> pop(std::size_t count) {
     std::vector<std::uint32_t> batch;
-    batch.reserve(std::min(count, queue_.size()));
-    while (batch.size() < count && queue_.size() > 0) batch.push_back(queue_.pop());
+    while (batch.size() < count && queue_.size() > 0)
+      for (std::uint32_t p : queue_.pop(count - batch.size()))
+        if (!taken_.pixels[p]) {
+          taken_.pixels[p] = 1;
+          batch.push_back(p);
+        }
     return batch;
   }
 
@@ -100,13 +124,20 @@ class Refiner {
 
  private:
   void offer(int x, int y) {
-    if (known(x, y) || queued_(x, y)) return;
-    const int level = pattern_.level(x, y);
+    if (known(x, y) || taken_(x, y)) return;
+    const int level = pattern_.level(x, y), lattice = 2 * parent_offset(level, pattern_.base_spacing);
     std::array<float, 4> lo{INFINITY, INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY, -INFINITY};
     for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
       const int px = x + o[0], py = y + o[1];
       if (px < 0 || py < 0 || px >= imp_.width || py >= imp_.height) continue;
-      if (!known(px, py)) return;  // offered again when this parent is traced
+      // Required: the corners of the square cell being split (for an edge midpoint, the edge's two ends).
+      // The squares' centres beside an edge midpoint only add contrast: requiring them would let a flat
+      // neighbour cell block the refinement of an edge cell.
+      const bool corner = px % lattice == 0 && py % lattice == 0;
+      if (!known(px, py)) {
+        if (corner) return;  // offered again when this corner is traced
+        continue;
+      }
       const Rgba& c = image_(px, py);
       const std::array<float, 4> v{std::sqrt(std::max(0.0f, c.r)), std::sqrt(std::max(0.0f, c.g)),
                                    std::sqrt(std::max(0.0f, c.b)), c.a};
@@ -117,9 +148,12 @@ class Refiner {
     }
     float contrast = 0;
     for (int k = 0; k < 4; ++k) contrast = std::max(contrast, hi[k] - lo[k]);
+    const auto pixel = std::uint32_t(y) * std::uint32_t(imp_.width) + std::uint32_t(x);
     const float priority = (contrast + options_.floor + options_.line_weight * imp_(x, y)) * std::ldexp(1.0f, -level);
-    queue_.push(priority, std::uint32_t(y) * std::uint32_t(imp_.width) + std::uint32_t(x));
-    queued_(x, y) = 1;
+    // Offered again when another parent was traced: only a clearly higher priority is worth a second entry.
+    if (priority <= 1.05f * offered_(x, y)) return;
+    queue_.push(priority, pixel);
+    offered_(x, y) = priority;
   }
 
   const ImageF& imp_;
@@ -127,7 +161,8 @@ class Refiner {
   const RefinementOptions& options_;
   ImageRGBA& image_;
   ImageMask& traced_;
-  ImageMask queued_;
+  ImageMask taken_;   ///< popped for tracing
+  ImageF offered_;    ///< highest priority offered so far (0 = never)
   BucketQueue queue_;
 };
 
@@ -142,18 +177,18 @@ void in_hashed_tile_order(std::vector<std::uint32_t>& batch, int width, std::uin
   std::sort(batch.begin(), batch.end(), [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
 }
 
-// Rays to launch in the next round: a quarter of what is left, so late rounds see the early rounds' samples.
+// Rays to launch in the next round: an eighth of what is left, so late rounds see the early rounds' samples.
 std::size_t round_size(const RefinementStop& stop, std::size_t done, double rays_per_ms) {
-  std::size_t left;
   if (stop.now) {
     const double ms = stop.deadline_ms - (*stop.now)();
     if (ms <= 0) return 0;
-    left = std::size_t(std::max(1.0, ms * rays_per_ms));
+    // The estimate only sizes the round; trace_until stops at the deadline whatever it says.
+    return std::max(kMinRound, std::size_t(ms * rays_per_ms) / 8);
   } else {
-    if (done >= stop.rays) return 0;
-    left = stop.rays - done;
   }
-  return std::min(left, std::max(kMinRound, left / 4));
+  if (done >= stop.rays) return 0;
+  const std::size_t left = stop.rays - done;
+  return std::min(left, std::max(kMinRound, left / 8));
 }
 
 }  // namespace
@@ -178,14 +213,18 @@ RefinementResult trace_refined(const ImageF& importance, const FractalPattern& p
   result.level0_overran = stop.now && (*stop.now)() > stop.deadline_ms;
   double rays_per_ms = double(level0.size()) / level0_ms;
 
-  Refiner refiner(importance, pattern, options, image, traced);
+  Refiner refiner(importance, pattern, options, seed, image, traced);
   refiner.offer_orphans();
   for (std::uint32_t p : level0) refiner.offer_children(p);
   while (refiner.waiting() > 0) {
-    const std::size_t want = round_size(stop, result.rays, rays_per_ms);
+    // At most a quarter of the waiting candidates per round, so every round is a choice among them and an
+    // edge can be followed down several levels (one per round) before the budget is spent on breadth.
+    const std::size_t want = std::min(round_size(stop, result.rays, rays_per_ms),
+                                      std::max<std::size_t>(1, refiner.waiting() / 4));
     if (want == 0) break;
     std::vector<std::uint32_t> batch = refiner.pop(want);
     const std::size_t popped = batch.size();
+    if (popped == 0) break;  // only stale entries were left
     if (stop.now) {
       in_hashed_tile_order(batch, w, seed);
       const double start = clock();

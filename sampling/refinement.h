@@ -6,8 +6,8 @@
 /// per-channel spread of the parents (RGB through a square root, close to the sRGB the metrics see), 2^-l the
 /// share of the frame one ray of that level covers. The floor keeps coverage even where the samples agree
 /// (subsampling's strength on shaded texture). Candidates are traced in rounds of the highest priorities;
-/// each round's samples raise or lower their children's priorities. The traced set is always closed under
-/// parents, so the fractal reconstruction finds complete cells.
+/// each round's samples raise or lower their children's priorities. Every traced cell's corners are
+/// traced, so the hierarchical reconstruction (reconstruction.h) builds on them.
 #include <cstdint>
 
 #include "core/image.h"
