@@ -46,9 +46,14 @@ class BucketQueue {
         ++top_;
         continue;
       }
-      const auto hash = [this](std::uint32_t p) { return std::uint64_t(pixel_hash(p, seed_)) << 32 | p; };
-      std::sort(bucket.begin() + std::ptrdiff_t(next), bucket.end(),
-                [&](std::uint32_t a, std::uint32_t b) { return hash(a) < hash(b); });
+      // Each entry is sorted once: those offered since the bucket was last served, among themselves.
+      std::size_t& sorted = sorted_[top_];
+      if (sorted < bucket.size()) {
+        const auto hash = [this](std::uint32_t p) { return std::uint64_t(pixel_hash(p, seed_)) << 32 | p; };
+        std::sort(bucket.begin() + std::ptrdiff_t(std::max(sorted, next)), bucket.end(),
+                  [&](std::uint32_t a, std::uint32_t b) { return hash(a) < hash(b); });
+        sorted = bucket.size();
+      }
       const std::size_t take = std::min(count - out.size(), bucket.size() - next);
       out.insert(out.end(), bucket.begin() + std::ptrdiff_t(next), bucket.begin() + std::ptrdiff_t(next + take));
       next += take;
@@ -60,7 +65,7 @@ class BucketQueue {
 
  private:
   std::vector<std::vector<std::uint32_t>> buckets_;
-  std::array<std::size_t, kBuckets> next_{};
+  std::array<std::size_t, kBuckets> next_{}, sorted_{};
   std::uint64_t seed_;
   int top_ = kBuckets - 1;
   std::size_t size_ = 0;
@@ -79,6 +84,7 @@ class Refiner {
           std::uint64_t seed, ImageRGBA& image, ImageMask& traced)
       : imp_(importance), pattern_(pattern), options_(options), image_(image), traced_(traced),
         taken_(importance.width, importance.height, 0), offered_(importance.width, importance.height, 0.0f),
+        percept_(importance.width, importance.height, std::array<std::uint8_t, 4>{}),
         queue_(seed) {}
 
   bool known(int x, int y) const { return imp_(x, y) < 0 || traced_(x, y); }
@@ -96,6 +102,15 @@ class Refiner {
         }
         if (orphan) offer(x, y);
       }
+  }
+
+  // A traced pixel's values as the contrast sees them: RGB through a square root (close to sRGB), alpha,
+  // quantised to 1/255 (finer than any floor worth setting).
+  void record(std::uint32_t pixel) {
+    const Rgba& c = image_.pixels[pixel];
+    auto code = [](float v) { return std::uint8_t(std::lround(255.0f * std::min(1.0f, std::max(0.0f, v)))); };
+    percept_.pixels[pixel] = {code(std::sqrt(std::max(0.0f, c.r))), code(std::sqrt(std::max(0.0f, c.g))),
+                              code(std::sqrt(std::max(0.0f, c.b))), code(c.a)};
   }
 
   // After `pixel` was traced: the children it may have completed, at every finer level.
@@ -138,16 +153,15 @@ class Refiner {
         if (corner) return;  // offered again when this corner is traced
         continue;
       }
-      const Rgba& c = image_(px, py);
-      const std::array<float, 4> v{std::sqrt(std::max(0.0f, c.r)), std::sqrt(std::max(0.0f, c.g)),
-                                   std::sqrt(std::max(0.0f, c.b)), c.a};
+      const std::array<std::uint8_t, 4>& c = percept_(px, py);
+      const std::array<float, 4> v{float(c[0]), float(c[1]), float(c[2]), float(c[3])};
       for (int k = 0; k < 4; ++k) {
         lo[k] = std::min(lo[k], v[k]);
         hi[k] = std::max(hi[k], v[k]);
       }
     }
     float contrast = 0;
-    for (int k = 0; k < 4; ++k) contrast = std::max(contrast, hi[k] - lo[k]);
+    for (int k = 0; k < 4; ++k) contrast = std::max(contrast, (hi[k] - lo[k]) * (1.0f / 255.0f));
     const auto pixel = std::uint32_t(y) * std::uint32_t(imp_.width) + std::uint32_t(x);
     const float priority = (contrast + options_.floor + options_.line_weight * imp_(x, y)) * std::ldexp(1.0f, -level);
     // Offered again when another parent was traced: only a clearly higher priority is worth a second entry.
@@ -163,6 +177,8 @@ class Refiner {
   ImageMask& traced_;
   ImageMask taken_;   ///< popped for tracing
   ImageF offered_;    ///< highest priority offered so far (0 = never)
+  /// record()ed values of traced pixels in 1/255 steps (4 bytes a pixel); 0 on background, like its image.
+  Image<std::array<std::uint8_t, 4>> percept_;
   BucketQueue queue_;
 };
 
@@ -214,6 +230,7 @@ RefinementResult trace_refined(const ImageF& importance, const FractalPattern& p
   double rays_per_ms = double(level0.size()) / level0_ms;
 
   Refiner refiner(importance, pattern, options, seed, image, traced);
+  for (std::uint32_t p : level0) refiner.record(p);
   refiner.offer_orphans();
   for (std::uint32_t p : level0) refiner.offer_children(p);
   while (refiner.waiting() > 0) {
@@ -234,7 +251,10 @@ RefinementResult trace_refined(const ImageF& importance, const FractalPattern& p
       std::sort(batch.begin(), batch.end());  // scan order: neighbouring rays share volume blocks
       trace_all(batch, trace, image);
     }
-    for (std::uint32_t p : batch) traced.pixels[p] = 1;
+    for (std::uint32_t p : batch) {
+      traced.pixels[p] = 1;
+      refiner.record(p);
+    }
     for (std::uint32_t p : batch) refiner.offer_children(p);
     result.rays += batch.size();
     if (batch.size() < popped) break;  // the deadline cut the round
