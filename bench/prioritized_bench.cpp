@@ -169,13 +169,13 @@ void run_scene(const Scene& sc, const Setup& setup, int width, int height, bool 
   }
 
   std::vector<TimedError> curve;
-  std::printf("subsample curve: fraction ms (x full) FLIP_obj 1-SSIM_obj 1-SSIMlin_obj\n");
+  std::printf("subsample curve (min time of 3): fraction ms (x full) FLIP_obj 1-SSIM_obj 1-SSIMlin_obj\n");
   for (double f : {0.03, 0.05, 0.075, 0.1, 0.15, 0.2, 0.3, 0.4, 0.55, 0.7}) {
     sampling::SamplingOptions s = setup.sampling;
     s.mode = sampling::SamplingMode::Subsample;
     s.ray_fraction = f;
     TimedError best{1e300, {}};
-    for (int r = 0; r < 2; ++r) {
+    for (int r = 0; r < 3; ++r) {
       const TimedError e = sampled_frame(caster, background, bg_ms, s, full);
       if (e.ms < best.ms) best = e;
     }
@@ -185,14 +185,24 @@ void run_scene(const Scene& sc, const Setup& setup, int width, int height, bool 
                 best.reconstruct_ms);
   }
 
-  std::printf("equal time: mode, budget (share of full), frame ms (x full), ratio to subsample at that time:"
+  std::printf("equal time (best of 3 frames by rays traced): mode, budget (share of full), frame ms (x full), ratio to subsample at that time:"
               " FLIP_obj  1-SSIM_obj  1-SSIMlin_obj\n");
+  // A budgeted frame's work depends on how much of the machine it got: of three frames keep the one that
+  // traced the most rays, the counterpart of the subsample curve's minimum time over repeats.
+  auto least_disturbed = [&](const ImageF& importance, double importance_ms, const sampling::SamplingOptions& s) {
+    TimedError best;
+    for (int r = 0; r < 3; ++r) {
+      const TimedError e = sampled_frame(caster, importance, importance_ms, s, full);
+      if (r == 0 || e.rays > best.rays) best = e;
+    }
+    return best;
+  };
   for (double share : {0.1, 0.2, 0.4}) {
     sampling::SamplingOptions s = setup.sampling;
     s.budget_ms = share * full_ms;
-    const TimedError today = sampled_frame(caster, lines, lines_ms, s, full);
-    const TimedError cheap = sampled_frame(caster, lines, 0.05 * full_ms, s, full);
-    const TimedError ctrl = sampled_frame(caster, control, bg_ms, s, full);
+    const TimedError today = least_disturbed(lines, lines_ms, s);
+    const TimedError cheap = least_disturbed(lines, 0.05 * full_ms, s);
+    const TimedError ctrl = least_disturbed(control, bg_ms, s);
     print_ratio_row("prioritized, today's imp.", share, today, error_at_time(curve, today.ms), full_ms);
     print_ratio_row("prioritized, imp. at 5%", share, cheap, error_at_time(curve, cheap.ms), full_ms);
     print_ratio_row("control (no lines)", share, ctrl, error_at_time(curve, ctrl.ms), full_ms);

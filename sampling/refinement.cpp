@@ -182,6 +182,16 @@ class Refiner {
   BucketQueue queue_;
 };
 
+// A round in 16x16 tiles, tile rows top to bottom: the caster traces each group of kRayGroup rays together,
+// and a compact group shares volume blocks (scan order would stretch a group of sparse rays along a row).
+void in_tile_order(std::vector<std::uint32_t>& batch, int width) {
+  auto key = [width](std::uint32_t p) {
+    const std::uint32_t x = p % std::uint32_t(width), y = p / std::uint32_t(width);
+    return std::uint64_t((y / 16) * 4096u + x / 16) << 32 | p;
+  };
+  std::sort(batch.begin(), batch.end(), [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
+}
+
 // A budgeted round in 16x16 tiles (neighbouring rays share volume blocks), the tiles in a hashed order, so the
 // prefix the deadline leaves is spread over the frame rather than its top rows.
 void in_hashed_tile_order(std::vector<std::uint32_t>& batch, int width, std::uint64_t seed) {
@@ -217,6 +227,7 @@ RefinementResult trace_refined(const ImageF& importance, const FractalPattern& p
   for (int y = 0; y < h; y += pattern.base_spacing)
     for (int x = 0; x < w; x += pattern.base_spacing)
       if (importance(x, y) >= 0) level0.push_back(std::uint32_t(y) * std::uint32_t(w) + std::uint32_t(x));
+  in_tile_order(level0, w);
   // Budget rounds are sized from the rate measured on the stop's own clock (the deadline decides anyway).
   const Timer wall;
   const ElapsedMs clock = stop.now ? *stop.now : ElapsedMs([&wall] { return wall.elapsed_ms(); });
@@ -248,7 +259,7 @@ RefinementResult trace_refined(const ImageF& importance, const FractalPattern& p
       batch.resize(trace_until(batch, trace, image, *stop.now, stop.deadline_ms));
       rays_per_ms = std::max(rays_per_ms * 0.25, double(batch.size()) / std::max(1e-3, clock() - start));
     } else {
-      std::sort(batch.begin(), batch.end());  // scan order: neighbouring rays share volume blocks
+      in_tile_order(batch, w);
       trace_all(batch, trace, image);
     }
     for (std::uint32_t p : batch) {
