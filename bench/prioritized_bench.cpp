@@ -135,114 +135,143 @@ void print_ratio_row(const char* what, double share, const TimedError& m, const 
               m.error.dssim_linear / sub.dssim_linear, m.rays, m.trace_ms, m.reconstruct_ms);
 }
 
+// One scene's view with its full render and importance buffers; each table is one member function.
+struct SceneRun {
+  const Setup& setup;
+  volume::RayCaster caster;
+  sampling::FeatureGeometry geometry;
+  ImageRGBA full;
+  ImageF lines, background, control;
+  double full_ms = 0, lines_ms = 0, bg_ms = 0;
+  std::vector<TimedError> curve;  ///< subsampling's time->error curve
+
+  SceneRun(const Scene& sc, const Setup& s, const CameraSpec& cam, const volume::RenderOptions& render)
+      : setup(s), caster(sc.vol, sc.tf, cam, render), geometry(sampling::build_feature_geometry(sc.vol, sc.tf)) {
+    full_ms = min_ms(2, [&] { full = volume::render_full(caster).image; });
+    lines_ms = min_ms(2, [&] { lines = sampling::frame_importance(caster, &geometry, setup.features); });
+    bg_ms = min_ms(2, [&] { background = sampling::frame_importance(caster, nullptr, {}); });
+    control = sampling::control_importance(background);
+    std::printf("\n== %s: full frame %.0f ms; importance (background + lines) %.0f ms = %.1f%% of it, background "
+                "test alone %.0f ms; feature mesh %zu triangles, setup %.0f ms (view-independent)\n",
+                sc.label.c_str(), full_ms, lines_ms, 100 * lines_ms / full_ms, bg_ms,
+                geometry.mesh.triangles.size(), geometry.build_ms);
+  }
+
+  TimedError frame(const ImageF& importance, double importance_ms, const sampling::SamplingOptions& s) const {
+    return sampled_frame(caster, importance, importance_ms, s, full);
+  }
+
+  // Each mode's own cost without the rays: the same frame with a tracer that returns at once.
+  void overhead() const {
+    const sampling::TraceBatch no_trace = [](Span<const std::uint32_t>, Span<Rgba> out) {
+      for (Rgba& c : out) c = Rgba{0.5f, 0.5f, 0.5f, 1.0f};
+    };
+    for (double f : {0.1, 0.4}) {
+      sampling::SamplingOptions s = setup.sampling;
+      s.ray_fraction = f;
+      const double p_ms = min_ms(3, [&] { sampling::render_sampled(lines, no_trace, s); });
+      s.mode = sampling::SamplingMode::Subsample;
+      const double s_ms = min_ms(3, [&] { sampling::render_sampled(background, no_trace, s); });
+      std::printf("overhead without rays at fraction %.1f: prioritized %.1f ms, subsample %.1f ms\n", f, p_ms, s_ms);
+    }
+  }
+
+  void subsample_curve() {
+    std::printf("subsample curve (min time of 3): fraction ms (x full) FLIP_obj 1-SSIM_obj 1-SSIMlin_obj\n");
+    for (double f : {0.03, 0.05, 0.075, 0.1, 0.15, 0.2, 0.3, 0.4, 0.55, 0.7}) {
+      sampling::SamplingOptions s = setup.sampling;
+      s.mode = sampling::SamplingMode::Subsample;
+      s.ray_fraction = f;
+      TimedError best{1e300, {}};
+      for (int r = 0; r < 3; ++r) {
+        const TimedError e = frame(background, bg_ms, s);
+        if (e.ms < best.ms) best = e;
+      }
+      curve.push_back(best);
+      std::printf("  %.3f %7.0f (%4.2f) %.4f %.4f %.4f  [%zu rays, trace %.0f ms, reconstruct %.0f ms]\n", f,
+                  best.ms, best.ms / full_ms, best.error.flip, best.error.dssim, best.error.dssim_linear, best.rays,
+                  best.trace_ms, best.reconstruct_ms);
+    }
+  }
+
+  // A budgeted frame's work depends on how much of the machine it got: of three frames keep the one that
+  // traced the most rays, the counterpart of the subsample curve's minimum time over repeats.
+  TimedError least_disturbed(const ImageF& importance, double importance_ms, const sampling::SamplingOptions& s) const {
+    TimedError best;
+    for (int r = 0; r < 3; ++r) {
+      const TimedError e = frame(importance, importance_ms, s);
+      if (r == 0 || e.rays > best.rays) best = e;
+    }
+    return best;
+  }
+
+  void equal_time() const {
+    std::printf("equal time (best of 3 frames by rays traced): mode, budget (share of full), frame ms (x full), "
+                "ratio to subsample at that time: FLIP_obj  1-SSIM_obj  1-SSIMlin_obj\n");
+    for (double share : {0.1, 0.2, 0.4}) {
+      sampling::SamplingOptions s = setup.sampling;
+      s.budget_ms = share * full_ms;
+      const TimedError today = least_disturbed(lines, lines_ms, s);
+      const TimedError cheap = least_disturbed(lines, 0.05 * full_ms, s);
+      const TimedError ctrl = least_disturbed(control, bg_ms, s);
+      print_ratio_row("prioritized, today's imp.", share, today, error_at_time(curve, today.ms), full_ms);
+      print_ratio_row("prioritized, imp. at 5%", share, cheap, error_at_time(curve, cheap.ms), full_ms);
+      print_ratio_row("control (no lines)", share, ctrl, error_at_time(curve, ctrl.ms), full_ms);
+    }
+  }
+
+  void equal_rays() const {
+    std::printf("equal rays (secondary): fraction, prioritized/subsample and control/subsample: FLIP 1-SSIM "
+                "1-SSIMlin\n");
+    for (std::size_t k : {3u, 5u, 7u}) {  // fractions 0.1, 0.2, 0.4 of the curve
+      sampling::SamplingOptions s = setup.sampling;
+      s.ray_fraction = k == 3 ? 0.1 : k == 5 ? 0.2 : 0.4;
+      const TimedError pt = frame(lines, 0.05 * full_ms, s), ct = frame(control, bg_ms, s);
+      const Error &p = pt.error, &c = ct.error, &sub = curve[k].error;
+      std::printf("  %.1f  %6.3f %6.3f %6.3f   %6.3f %6.3f %6.3f   [prioritized (imp. at 5%%) %.0f ms, trace %.0f ms; "
+                  "control %.0f ms, trace %.0f ms]\n", s.ray_fraction, p.flip / sub.flip, p.dssim / sub.dssim,
+                  p.dssim_linear / sub.dssim_linear, c.flip / sub.flip, c.dssim / sub.dssim,
+                  c.dssim_linear / sub.dssim_linear, pt.ms, pt.trace_ms, ct.ms, ct.trace_ms);
+    }
+  }
+
+  // Budget mode through the real pipeline (importance included): whole frames against the budget.
+  void budget_table() const {
+    std::printf("budget mode (%d frames each, today's importance): budget_ms p50_ms p95_ms p95/budget mean_rays "
+                "level0_only\n", setup.budget_frames);
+    for (double share : {0.1, 0.2, 0.4, 0.8}) {
+      sampling::SamplingOptions s = setup.sampling;
+      s.budget_ms = share * full_ms;
+      std::vector<double> times;
+      double rays = 0, reserve = -1;
+      int level0_only = 0;
+      for (int k = 0; k < setup.budget_frames; ++k) {
+        s.reconstruct_reserve_ms = reserve;  // the previous frame's measured reconstruction (x1.25), as in RP §5
+        const sampling::VolumeFrame f = sampling::render_volume_frame(caster, &geometry, setup.features, s);
+        times.push_back(f.total_ms);
+        rays += double(f.sampled.rays_traced);
+        level0_only += f.sampled.budget_too_small;
+        reserve = 1.25 * f.sampled.reconstruct_ms;
+      }
+      const double p95 = percentile(times, 0.95);
+      std::printf("  %3.0f%% of full %8.0f %6.0f %6.0f %8.3f %9.0f %d\n", share * 100, s.budget_ms,
+                  percentile(times, 0.5), p95, p95 / s.budget_ms, rays / setup.budget_frames, level0_only);
+    }
+  }
+};
+
 void run_scene(const Scene& sc, const Setup& setup, int width, int height, bool budget_table) {
   CameraSpec cam = sc.camera;
   cam.width = width;
   cam.height = height;
   volume::RenderOptions render;
   render.shading = volume::Shading::Phong;
-  const volume::RayCaster caster(sc.vol, sc.tf, cam, render);
-  const sampling::FeatureGeometry geometry = sampling::build_feature_geometry(sc.vol, sc.tf);
-
-  ImageRGBA full;
-  const double full_ms = min_ms(2, [&] { full = volume::render_full(caster).image; });
-  ImageF lines, background;
-  const double lines_ms = min_ms(2, [&] { lines = sampling::frame_importance(caster, &geometry, setup.features); });
-  const double bg_ms = min_ms(2, [&] { background = sampling::frame_importance(caster, nullptr, {}); });
-  const ImageF control = sampling::control_importance(background);
-  std::printf("\n== %s: full frame %.0f ms; importance (background + lines) %.0f ms = %.1f%% of it, background "
-              "test alone %.0f ms; feature mesh %zu triangles, setup %.0f ms (view-independent)\n",
-              sc.label.c_str(), full_ms, lines_ms, 100 * lines_ms / full_ms, bg_ms, geometry.mesh.triangles.size(),
-              geometry.build_ms);
-
-  // Each mode's own cost without the rays: the same frame with a tracer that returns at once.
-  const sampling::TraceBatch no_trace = [](Span<const std::uint32_t>, Span<Rgba> out) {
-    for (Rgba& c : out) c = Rgba{0.5f, 0.5f, 0.5f, 1.0f};
-  };
-  for (double f : {0.1, 0.4}) {
-    sampling::SamplingOptions s = setup.sampling;
-    s.ray_fraction = f;
-    const double p_ms = min_ms(3, [&] { sampling::render_sampled(lines, no_trace, s); });
-    s.mode = sampling::SamplingMode::Subsample;
-    const double s_ms = min_ms(3, [&] { sampling::render_sampled(background, no_trace, s); });
-    std::printf("overhead without rays at fraction %.1f: prioritized %.1f ms, subsample %.1f ms\n", f, p_ms, s_ms);
-  }
-
-  std::vector<TimedError> curve;
-  std::printf("subsample curve (min time of 3): fraction ms (x full) FLIP_obj 1-SSIM_obj 1-SSIMlin_obj\n");
-  for (double f : {0.03, 0.05, 0.075, 0.1, 0.15, 0.2, 0.3, 0.4, 0.55, 0.7}) {
-    sampling::SamplingOptions s = setup.sampling;
-    s.mode = sampling::SamplingMode::Subsample;
-    s.ray_fraction = f;
-    TimedError best{1e300, {}};
-    for (int r = 0; r < 3; ++r) {
-      const TimedError e = sampled_frame(caster, background, bg_ms, s, full);
-      if (e.ms < best.ms) best = e;
-    }
-    curve.push_back(best);
-    std::printf("  %.3f %7.0f (%4.2f) %.4f %.4f %.4f  [%zu rays, trace %.0f ms, reconstruct %.0f ms]\n", f, best.ms,
-                best.ms / full_ms, best.error.flip, best.error.dssim, best.error.dssim_linear, best.rays, best.trace_ms,
-                best.reconstruct_ms);
-  }
-
-  std::printf("equal time (best of 3 frames by rays traced): mode, budget (share of full), frame ms (x full), ratio to subsample at that time:"
-              " FLIP_obj  1-SSIM_obj  1-SSIMlin_obj\n");
-  // A budgeted frame's work depends on how much of the machine it got: of three frames keep the one that
-  // traced the most rays, the counterpart of the subsample curve's minimum time over repeats.
-  auto least_disturbed = [&](const ImageF& importance, double importance_ms, const sampling::SamplingOptions& s) {
-    TimedError best;
-    for (int r = 0; r < 3; ++r) {
-      const TimedError e = sampled_frame(caster, importance, importance_ms, s, full);
-      if (r == 0 || e.rays > best.rays) best = e;
-    }
-    return best;
-  };
-  for (double share : {0.1, 0.2, 0.4}) {
-    sampling::SamplingOptions s = setup.sampling;
-    s.budget_ms = share * full_ms;
-    const TimedError today = least_disturbed(lines, lines_ms, s);
-    const TimedError cheap = least_disturbed(lines, 0.05 * full_ms, s);
-    const TimedError ctrl = least_disturbed(control, bg_ms, s);
-    print_ratio_row("prioritized, today's imp.", share, today, error_at_time(curve, today.ms), full_ms);
-    print_ratio_row("prioritized, imp. at 5%", share, cheap, error_at_time(curve, cheap.ms), full_ms);
-    print_ratio_row("control (no lines)", share, ctrl, error_at_time(curve, ctrl.ms), full_ms);
-  }
-
-  std::printf("equal rays (secondary): fraction, prioritized/subsample and control/subsample: FLIP 1-SSIM 1-SSIMlin\n");
-  for (std::size_t k : {3u, 5u, 7u}) {  // fractions 0.1, 0.2, 0.4 of the curve
-    sampling::SamplingOptions s = setup.sampling;
-    s.ray_fraction = k == 3 ? 0.1 : k == 5 ? 0.2 : 0.4;
-    const TimedError pt = sampled_frame(caster, lines, 0.05 * full_ms, s, full);
-    const TimedError ct = sampled_frame(caster, control, bg_ms, s, full);
-    const Error &p = pt.error, &c = ct.error, &sub = curve[k].error;
-    std::printf("  %.1f  %6.3f %6.3f %6.3f   %6.3f %6.3f %6.3f   [prioritized (imp. at 5%%) %.0f ms, trace %.0f ms; "
-                "control %.0f ms, trace %.0f ms]\n", s.ray_fraction, p.flip / sub.flip, p.dssim / sub.dssim,
-                p.dssim_linear / sub.dssim_linear, c.flip / sub.flip, c.dssim / sub.dssim,
-                c.dssim_linear / sub.dssim_linear, pt.ms, pt.trace_ms, ct.ms, ct.trace_ms);
-  }
-
-  if (!budget_table || setup.budget_frames < 1) return;
-  std::printf("budget mode (%d frames each, today's importance): budget_ms p50_ms p95_ms p95/budget mean_rays "
-              "level0_only\n", setup.budget_frames);
-  for (double share : {0.1, 0.2, 0.4, 0.8}) {
-    sampling::SamplingOptions s = setup.sampling;
-    s.budget_ms = share * full_ms;
-    std::vector<double> times;
-    double rays = 0;
-    int level0_only = 0;
-    double reserve = -1;
-    for (int k = 0; k < setup.budget_frames; ++k) {
-      s.reconstruct_reserve_ms = reserve;  // the previous frame's measured reconstruction (x1.25), as in RP §5
-      const sampling::VolumeFrame frame = sampling::render_volume_frame(caster, &geometry, setup.features, s);
-      times.push_back(frame.total_ms);
-      rays += double(frame.sampled.rays_traced);
-      level0_only += frame.sampled.budget_too_small;
-      reserve = 1.25 * frame.sampled.reconstruct_ms;
-    }
-    const double p95 = percentile(times, 0.95);
-    std::printf("  %3.0f%% of full %8.0f %6.0f %6.0f %8.3f %9.0f %d\n", share * 100, s.budget_ms,
-                percentile(times, 0.5), p95, p95 / s.budget_ms, rays / setup.budget_frames, level0_only);
-  }
+  SceneRun run(sc, setup, cam, render);
+  run.overhead();
+  run.subsample_curve();
+  run.equal_time();
+  run.equal_rays();
+  if (budget_table && setup.budget_frames > 0) run.budget_table();
 }
 
 bool listed(const std::string& list, const std::string& name) {
