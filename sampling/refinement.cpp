@@ -25,6 +25,16 @@ int bucket_of(float priority) {
   return std::min(kBuckets - 1, std::max(0, b + 2 * kBucketsPerOctave));  // priorities up to 4 get bucket >= 0
 }
 
+// Sorts [first, last) by key(pixel), each key computed once (the keys hash, so a comparator would rehash).
+template <typename It, typename Key>
+void sort_by_key(It first, It last, const Key& key) {
+  std::vector<std::uint64_t> keyed;
+  keyed.reserve(std::size_t(last - first));
+  for (It it = first; it != last; ++it) keyed.push_back(key(*it));
+  std::sort(keyed.begin(), keyed.end());
+  for (std::uint64_t k : keyed) *first++ = std::uint32_t(k & 0xFFFFFFFFu);
+}
+
 class BucketQueue {
  public:
   explicit BucketQueue(std::uint64_t seed) : buckets_(kBuckets), seed_(seed) {}
@@ -49,9 +59,9 @@ class BucketQueue {
       // Each entry is sorted once: those offered since the bucket was last served, among themselves.
       std::size_t& sorted = sorted_[top_];
       if (sorted < bucket.size()) {
-        const auto hash = [this](std::uint32_t p) { return std::uint64_t(pixel_hash(p, seed_)) << 32 | p; };
-        std::sort(bucket.begin() + std::ptrdiff_t(std::max(sorted, next)), bucket.end(),
-                  [&](std::uint32_t a, std::uint32_t b) { return hash(a) < hash(b); });
+        const std::size_t from = std::max(sorted, next);
+        sort_by_key(bucket.begin() + std::ptrdiff_t(from), bucket.end(),
+                    [this](std::uint32_t p) { return std::uint64_t(pixel_hash(p, seed_)) << 32 | p; });
         sorted = bucket.size();
       }
       const std::size_t take = std::min(count - out.size(), bucket.size() - next);
@@ -185,22 +195,19 @@ class Refiner {
 // A round in 16x16 tiles, tile rows top to bottom: the caster traces each group of kRayGroup rays together,
 // and a compact group shares volume blocks (scan order would stretch a group of sparse rays along a row).
 void in_tile_order(std::vector<std::uint32_t>& batch, int width) {
-  auto key = [width](std::uint32_t p) {
+  sort_by_key(batch.begin(), batch.end(), [width](std::uint32_t p) {
     const std::uint32_t x = p % std::uint32_t(width), y = p / std::uint32_t(width);
     return std::uint64_t((y / 16) * 4096u + x / 16) << 32 | p;
-  };
-  std::sort(batch.begin(), batch.end(), [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
+  });
 }
 
 // A budgeted round in 16x16 tiles (neighbouring rays share volume blocks), the tiles in a hashed order, so the
 // prefix the deadline leaves is spread over the frame rather than its top rows.
 void in_hashed_tile_order(std::vector<std::uint32_t>& batch, int width, std::uint64_t seed) {
-  auto key = [width, seed](std::uint32_t p) {
+  sort_by_key(batch.begin(), batch.end(), [width, seed](std::uint32_t p) {
     const std::uint32_t x = p % std::uint32_t(width), y = p / std::uint32_t(width);
-    const std::uint32_t tile = (y / 16) * 4096u + x / 16;
-    return std::uint64_t(pixel_hash(tile, seed)) << 32 | p;
-  };
-  std::sort(batch.begin(), batch.end(), [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
+    return std::uint64_t(pixel_hash((y / 16) * 4096u + x / 16, seed)) << 32 | p;
+  });
 }
 
 // Rays to launch in the next round: an eighth of what is left, so late rounds see the early rounds' samples.
