@@ -1,15 +1,21 @@
-// The prioritized-rendering trade in one run (issue targets, docs/prioritized.md):
-//  * quality: FLIP_object and 1-SSIM_object of prioritized vs equal-ray subsampling and vs the
-//    pattern-only control, at ray fractions 0.1 0.2 0.4 0.7, 1440x900, on the bundled engine CT (two
-//    views: opaque and translucent TF) and the MRI head;
-//  * speed: whole-frame time at the smallest fraction with SSIM_object >= 0.97 vs the full render;
-//  * budget mode: p95 frame time vs the budget for budgets of 10-80% of the full render time.
-// Usage: prioritized_bench [--quick] [--alpha a00,a10,a01,a11,a20,a02] [--budget-frames N]
-//   --quick renders 720x450 (for a smoke run); the numbers in the docs come from the default.
+// The prioritized-rendering trade at EQUAL FRAME TIME (issue 13 item 3, docs/prioritized.md), in one run:
+//  * subsampling's time->error curve (fractions 0.03..0.7; frame = background test + trace + upscale);
+//  * prioritized (--budget-ms T, contours + silhouettes) and the control (no lines) at T = 10/20/40% of the
+//    full frame, each frame's measured time placed on subsampling's curve: ratios prioritized/subsample and
+//    control/subsample of FLIP_object, 1-SSIM_object on sRGB luma and on linear luminance (object = alpha > 0
+//    in the full render). Prioritized twice: with today's importance cost, and with the importance charged at
+//    5% of the full frame (issue 13 item 2's target; the rays and reconstruction are the real ones);
+//  * the equal-ray ratios at fractions 0.1/0.2/0.4 as a secondary view;
+//  * budget mode p95 / budget on the engine CT.
+// Scenes: engine CT opaque and translucent (second view), MRI head opaque and translucent, and with --unseen
+// the smoke VDB from /work/shared/datasets with a TF written once (normalised to its value range) and never tuned.
+// Usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--linear] [--floor F] [--line-weight W]
+//                          [--alpha a00,...,a02] [--budget-frames N]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -28,21 +34,58 @@ struct SceneCase {
   bool rotate_view = false;  ///< second view of the same volume: eye rotated 90 degrees about the target
 };
 
-CameraSpec load_camera(const SceneCase& c, int width, int height) {
-  const std::string dir = std::string(RAYSIFT_SOURCE_DIR) + "/datasets/";
-  CameraSpec cam = camera_spec_from_json(read_json_file(dir + c.camera), dir + c.camera);
-  cam.width = width;
-  cam.height = height;
-  if (c.rotate_view) {
-    // Rotate the eye about the camera's up axis through the target (up is a principal axis here).
-    const Vec3d d = cam.eye - cam.target;
-    const Vec3d u = cam.up * (1.0 / std::sqrt(cam.up.x * cam.up.x + cam.up.y * cam.up.y + cam.up.z * cam.up.z));
-    const double along = d.x * u.x + d.y * u.y + d.z * u.z;
-    const Vec3d par = u * along, perp = d - par;
-    const Vec3d side{u.y * perp.z - u.z * perp.y, u.z * perp.x - u.x * perp.z, u.x * perp.y - u.y * perp.x};
-    cam.eye = cam.target + par + side;
-  }
+CameraSpec rotated(CameraSpec cam) {
+  // Rotate the eye about the camera's up axis through the target (up is a principal axis here).
+  const Vec3d d = cam.eye - cam.target;
+  const Vec3d u = cam.up * (1.0 / std::sqrt(cam.up.x * cam.up.x + cam.up.y * cam.up.y + cam.up.z * cam.up.z));
+  const double along = d.x * u.x + d.y * u.y + d.z * u.z;
+  const Vec3d par = u * along, perp = d - par;
+  const Vec3d side{u.y * perp.z - u.z * perp.y, u.z * perp.x - u.x * perp.z, u.x * perp.y - u.y * perp.x};
+  cam.eye = cam.target + par + side;
   return cam;
+}
+
+// The unseen volume's view: from the bounding box only (no look at the data).
+CameraSpec box_camera(const volume::Volume& vol) {
+  const volume::GridInfo info = vol.info();
+  CameraSpec cam;
+  cam.target = (info.bbox_min + info.bbox_max) * 0.5;
+  const Vec3d e = info.bbox_max - info.bbox_min;
+  const double diag = std::sqrt(e.x * e.x + e.y * e.y + e.z * e.z);
+  cam.eye = cam.target + Vec3d{0.6, 0.3, 0.75} * (2.2 * diag / std::sqrt(0.36 + 0.09 + 0.5625));
+  cam.up = {0, 1, 0};
+  cam.fov_y_deg = 30;
+  return cam;
+}
+
+// One image's error against the full render over its object pixels.
+struct Error {
+  double flip = 0, dssim = 0, dssim_linear = 0;
+};
+struct TimedError {
+  double ms = 0;
+  Error error;
+  std::size_t rays = 0;
+  double trace_ms = 0, reconstruct_ms = 0;
+};
+
+Error error_of(const ImageRGBA& full, const ImageRGBA& image) {
+  const sampling::Comparison c = sampling::compare_images(full, image);  // object = alpha > 0 of `full`
+  return {c.object.flip, 1 - c.object.ssim, 1 - c.object.ssim_linear};
+}
+
+// Subsampling's error at frame time `ms`, linear between the bracketing measured points (clamped at the ends).
+Error error_at_time(std::vector<TimedError> curve, double ms) {
+  std::sort(curve.begin(), curve.end(), [](const TimedError& a, const TimedError& b) { return a.ms < b.ms; });
+  if (ms <= curve.front().ms) return curve.front().error;
+  if (ms >= curve.back().ms) return curve.back().error;
+  std::size_t k = 1;
+  while (curve[k].ms < ms) ++k;
+  const TimedError &a = curve[k - 1], &b = curve[k];
+  const double t = (ms - a.ms) / std::max(1e-9, b.ms - a.ms);
+  auto lerp = [t](double u, double v) { return u + t * (v - u); };
+  return {lerp(a.error.flip, b.error.flip), lerp(a.error.dssim, b.error.dssim),
+          lerp(a.error.dssim_linear, b.error.dssim_linear)};
 }
 
 double percentile(std::vector<double> v, double p) {
@@ -52,108 +95,258 @@ double percentile(std::vector<double> v, double p) {
   return v[lo] + (v[hi] - v[lo]) * (idx - double(lo));
 }
 
-const sampling::TradeRow* find(const std::vector<sampling::TradeRow>& rows, const char* mode, double f) {
-  for (const auto& r : rows)
-    if (r.mode == mode && std::fabs(r.ray_fraction - f) < 1e-9) return &r;
-  return nullptr;
+template <typename F>
+double min_ms(int repeats, F&& f) {
+  double best = 1e300;
+  for (int r = 0; r < repeats; ++r) {
+    const Timer t;
+    f();
+    best = std::min(best, t.elapsed_ms());
+  }
+  return best;
+}
+
+struct Setup {
+  sampling::SamplingOptions sampling;  ///< alpha, refinement; mode/fraction/budget set per row
+  sampling::FeatureOptions features;
+  int budget_frames = 10;
+};
+
+struct Scene {
+  std::string label;
+  volume::Volume vol;
+  volume::TransferFunction tf;
+  CameraSpec camera;
+};
+
+// A sampled frame from a precomputed importance, its importance cost charged as `importance_ms`.
+TimedError sampled_frame(const volume::RayCaster& caster, const ImageF& importance, double importance_ms,
+                         sampling::SamplingOptions s, const ImageRGBA& full) {
+  const Timer t;
+  const sampling::SampledFrame f = sampling::render_sampled(importance, sampling::caster_trace_batch(caster), s,
+                                                            importance_ms);
+  const ImageRGBA image = sampling::composite_frame(f.image, caster.options().background);
+  return {importance_ms + t.elapsed_ms(), error_of(full, image), f.rays_traced, f.trace_ms, f.reconstruct_ms};
+}
+
+void print_ratio_row(const char* what, double share, const TimedError& m, const Error& sub, double full_ms) {
+  std::printf("  %-26s %3.0f%%  %7.0f ms (%4.2f)  %6.3f  %6.3f  %6.3f   [%zu rays, trace %.0f ms, reconstruct %.0f ms]\n",
+              what, share * 100, m.ms, m.ms / full_ms, m.error.flip / sub.flip, m.error.dssim / sub.dssim,
+              m.error.dssim_linear / sub.dssim_linear, m.rays, m.trace_ms, m.reconstruct_ms);
+}
+
+// One scene's view with its full render and importance buffers; each table is one member function.
+struct SceneRun {
+  const Setup& setup;
+  volume::RayCaster caster;
+  sampling::FeatureGeometry geometry;
+  ImageRGBA full;
+  ImageF lines, background, control;
+  double full_ms = 0, lines_ms = 0, bg_ms = 0;
+  std::vector<TimedError> curve;  ///< subsampling's time->error curve
+
+  SceneRun(const Scene& sc, const Setup& s, const CameraSpec& cam, const volume::RenderOptions& render)
+      : setup(s), caster(sc.vol, sc.tf, cam, render), geometry(sampling::build_feature_geometry(sc.vol, sc.tf)) {
+    full_ms = min_ms(2, [&] { full = volume::render_full(caster).image; });
+    lines_ms = min_ms(2, [&] { lines = sampling::frame_importance(caster, &geometry, setup.features); });
+    bg_ms = min_ms(2, [&] { background = sampling::frame_importance(caster, nullptr, {}); });
+    control = sampling::control_importance(background);
+    std::printf("\n== %s: full frame %.0f ms; importance (background + lines) %.0f ms = %.1f%% of it, background "
+                "test alone %.0f ms; feature mesh %zu triangles, setup %.0f ms (view-independent)\n",
+                sc.label.c_str(), full_ms, lines_ms, 100 * lines_ms / full_ms, bg_ms,
+                geometry.mesh.triangles.size(), geometry.build_ms);
+  }
+
+  TimedError frame(const ImageF& importance, double importance_ms, const sampling::SamplingOptions& s) const {
+    return sampled_frame(caster, importance, importance_ms, s, full);
+  }
+
+  // Each mode's own cost without the rays: the same frame with a tracer that returns at once.
+  void overhead() const {
+    const sampling::TraceBatch no_trace = [](Span<const std::uint32_t>, Span<Rgba> out) {
+      for (Rgba& c : out) c = Rgba{0.5f, 0.5f, 0.5f, 1.0f};
+    };
+    for (double f : {0.1, 0.4}) {
+      sampling::SamplingOptions s = setup.sampling;
+      s.ray_fraction = f;
+      const double p_ms = min_ms(3, [&] { sampling::render_sampled(lines, no_trace, s); });
+      s.mode = sampling::SamplingMode::Subsample;
+      const double s_ms = min_ms(3, [&] { sampling::render_sampled(background, no_trace, s); });
+      std::printf("overhead without rays at fraction %.1f: prioritized %.1f ms, subsample %.1f ms\n", f, p_ms, s_ms);
+    }
+  }
+
+  void subsample_curve() {
+    std::printf("subsample curve (min time of 3): fraction ms (x full) FLIP_obj 1-SSIM_obj 1-SSIMlin_obj\n");
+    for (double f : {0.03, 0.05, 0.075, 0.1, 0.15, 0.2, 0.3, 0.4, 0.55, 0.7}) {
+      sampling::SamplingOptions s = setup.sampling;
+      s.mode = sampling::SamplingMode::Subsample;
+      s.ray_fraction = f;
+      TimedError best{1e300, {}};
+      for (int r = 0; r < 3; ++r) {
+        const TimedError e = frame(background, bg_ms, s);
+        if (e.ms < best.ms) best = e;
+      }
+      curve.push_back(best);
+      std::printf("  %.3f %7.0f (%4.2f) %.4f %.4f %.4f  [%zu rays, trace %.0f ms, reconstruct %.0f ms]\n", f,
+                  best.ms, best.ms / full_ms, best.error.flip, best.error.dssim, best.error.dssim_linear, best.rays,
+                  best.trace_ms, best.reconstruct_ms);
+    }
+  }
+
+  // A budgeted frame's work depends on how much of the machine it got: of three frames keep the one that
+  // traced the most rays, the counterpart of the subsample curve's minimum time over repeats.
+  TimedError least_disturbed(const ImageF& importance, double importance_ms, const sampling::SamplingOptions& s) const {
+    TimedError best;
+    for (int r = 0; r < 3; ++r) {
+      const TimedError e = frame(importance, importance_ms, s);
+      if (r == 0 || e.rays > best.rays) best = e;
+    }
+    return best;
+  }
+
+  void equal_time() const {
+    std::printf("equal time (best of 3 frames by rays traced): mode, budget (share of full), frame ms (x full), "
+                "ratio to subsample at that time: FLIP_obj  1-SSIM_obj  1-SSIMlin_obj\n");
+    for (double share : {0.1, 0.2, 0.4}) {
+      sampling::SamplingOptions s = setup.sampling;
+      s.budget_ms = share * full_ms;
+      const TimedError today = least_disturbed(lines, lines_ms, s);
+      const TimedError cheap = least_disturbed(lines, 0.05 * full_ms, s);
+      const TimedError ctrl = least_disturbed(control, bg_ms, s);
+      print_ratio_row("prioritized, today's imp.", share, today, error_at_time(curve, today.ms), full_ms);
+      print_ratio_row("prioritized, imp. at 5%", share, cheap, error_at_time(curve, cheap.ms), full_ms);
+      print_ratio_row("control (no lines)", share, ctrl, error_at_time(curve, ctrl.ms), full_ms);
+    }
+  }
+
+  void equal_rays() const {
+    std::printf("equal rays (secondary): fraction, prioritized/subsample and control/subsample: FLIP 1-SSIM "
+                "1-SSIMlin\n");
+    for (std::size_t k : {3u, 5u, 7u}) {  // fractions 0.1, 0.2, 0.4 of the curve
+      sampling::SamplingOptions s = setup.sampling;
+      s.ray_fraction = k == 3 ? 0.1 : k == 5 ? 0.2 : 0.4;
+      const TimedError pt = frame(lines, 0.05 * full_ms, s), ct = frame(control, bg_ms, s);
+      const Error &p = pt.error, &c = ct.error, &sub = curve[k].error;
+      std::printf("  %.1f  %6.3f %6.3f %6.3f   %6.3f %6.3f %6.3f   [prioritized (imp. at 5%%) %.0f ms, trace %.0f ms; "
+                  "control %.0f ms, trace %.0f ms]\n", s.ray_fraction, p.flip / sub.flip, p.dssim / sub.dssim,
+                  p.dssim_linear / sub.dssim_linear, c.flip / sub.flip, c.dssim / sub.dssim,
+                  c.dssim_linear / sub.dssim_linear, pt.ms, pt.trace_ms, ct.ms, ct.trace_ms);
+    }
+  }
+
+  // Budget mode through the real pipeline (importance included): whole frames against the budget.
+  void budget_table() const {
+    std::printf("budget mode (%d frames each, today's importance): budget_ms p50_ms p95_ms p95/budget mean_rays "
+                "level0_only\n", setup.budget_frames);
+    for (double share : {0.1, 0.2, 0.4, 0.8}) {
+      sampling::SamplingOptions s = setup.sampling;
+      s.budget_ms = share * full_ms;
+      std::vector<double> times;
+      double rays = 0, reserve = -1;
+      int level0_only = 0;
+      for (int k = 0; k < setup.budget_frames; ++k) {
+        s.reconstruct_reserve_ms = reserve;  // the previous frame's measured reconstruction (x1.25), as in RP §5
+        const sampling::VolumeFrame f = sampling::render_volume_frame(caster, &geometry, setup.features, s);
+        times.push_back(f.total_ms);
+        rays += double(f.sampled.rays_traced);
+        level0_only += f.sampled.budget_too_small;
+        reserve = 1.25 * f.sampled.reconstruct_ms;
+      }
+      const double p95 = percentile(times, 0.95);
+      std::printf("  %3.0f%% of full %8.0f %6.0f %6.0f %8.3f %9.0f %d\n", share * 100, s.budget_ms,
+                  percentile(times, 0.5), p95, p95 / s.budget_ms, rays / setup.budget_frames, level0_only);
+    }
+  }
+};
+
+void run_scene(const Scene& sc, const Setup& setup, int width, int height, bool budget_table) {
+  CameraSpec cam = sc.camera;
+  cam.width = width;
+  cam.height = height;
+  volume::RenderOptions render;
+  render.shading = volume::Shading::Phong;
+  SceneRun run(sc, setup, cam, render);
+  run.overhead();
+  run.subsample_curve();
+  run.equal_time();
+  run.equal_rays();
+  if (budget_table && setup.budget_frames > 0) run.budget_table();
+}
+
+bool listed(const std::string& list, const std::string& name) {
+  if (list.empty()) return true;
+  std::stringstream in(list);
+  std::string item;
+  while (std::getline(in, item, ','))
+    if (item == name) return true;
+  return false;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool quick = false;
-  int budget_frames = 10;
-  sampling::PriorityMapping mapping;
+  bool quick = false, unseen = false;
+  std::string scenes;
+  Setup setup;
   for (int i = 1; i < argc; ++i) {
+    const bool more = i + 1 < argc;
     if (!std::strcmp(argv[i], "--quick")) quick = true;
-    else if (!std::strcmp(argv[i], "--alpha") && i + 1 < argc) mapping = sampling::parse_priority_mapping(argv[++i]);
-    else if (!std::strcmp(argv[i], "--budget-frames") && i + 1 < argc) budget_frames = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--unseen")) unseen = true;
+    else if (!std::strcmp(argv[i], "--no-refine")) setup.sampling.refinement.enabled = false;
+    else if (!std::strcmp(argv[i], "--linear")) setup.sampling.interpolation = sampling::Interpolation::Linear;
+    else if (!std::strcmp(argv[i], "--floor") && more) setup.sampling.refinement.floor = std::stof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--line-weight") && more) setup.sampling.refinement.line_weight = std::stof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--scenes") && more) scenes = argv[++i];
+    else if (!std::strcmp(argv[i], "--alpha") && more) setup.sampling.mapping = sampling::parse_priority_mapping(argv[++i]);
+    else if (!std::strcmp(argv[i], "--budget-frames") && more) setup.budget_frames = std::atoi(argv[++i]);
     else {
-      std::fprintf(stderr, "usage: prioritized_bench [--quick] [--alpha a00,...,a02] [--budget-frames N]\n");
+      std::fprintf(stderr, "usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--linear] [--floor F] "
+                           "[--line-weight W] [--alpha a00,...,a02] [--budget-frames N]\n");
       return 2;
     }
   }
+  setup.features.classes = sampling::parse_feature_list("contours,silhouettes");
   const int width = quick ? 720 : 1440, height = quick ? 450 : 900;
+  const auto& a = setup.sampling.mapping.alpha;
+  std::printf("prioritized_bench: %dx%d, phong, contours+silhouettes, %s reconstruction, refinement %s (floor %g, "
+              "line weight %g), alpha %g,%g,%g,%g,%g,%g\n", width, height,
+              setup.sampling.interpolation == sampling::Interpolation::Cubic ? "cubic" : "linear",
+              setup.sampling.refinement.enabled ? "on" : "off",
+              setup.sampling.refinement.floor, setup.sampling.refinement.line_weight, a[0], a[1], a[2], a[3], a[4],
+              a[5]);
   const std::string dir = std::string(RAYSIFT_SOURCE_DIR) + "/datasets/";
   const std::vector<SceneCase> cases = {
       {"engine_opaque", "engine_ct.vdb", "engine_ct_tf.json", "engine_ct_camera.json", false},
       {"engine_translucent", "engine_ct.vdb", "engine_ct_tf_translucent.json", "engine_ct_camera.json", true},
-      {"mri_head", "mri_head.vdb", "mri_head_tf.json", "mri_head_camera.json", false},
+      {"mri_opaque", "mri_head.vdb", "mri_head_tf.json", "mri_head_camera.json", false},
+      {"mri_translucent", "mri_head.vdb", "mri_head_tf_translucent.json", "mri_head_camera.json", false},
   };
-  std::printf("prioritized_bench: %dx%d, alpha %g,%g,%g,%g,%g,%g, features contours,silhouettes, phong\n", width,
-              height, mapping.alpha[0], mapping.alpha[1], mapping.alpha[2], mapping.alpha[3], mapping.alpha[4],
-              mapping.alpha[5]);
-
   for (const SceneCase& c : cases) {
-    const volume::Volume vol = volume::load_vdb(dir + c.volume);
-    const volume::TransferFunction tf = volume::load_transfer_function(dir + c.tf);
-    volume::RenderOptions render;
-    render.shading = volume::Shading::Phong;
-    const volume::RayCaster caster(vol, tf, load_camera(c, width, height), render);
-    const sampling::FeatureGeometry geometry = sampling::build_feature_geometry(vol, tf);
-
-    sampling::TradeOptions trade;
-    trade.sampling.mapping = mapping;
-    trade.features.classes = sampling::parse_feature_list("contours,silhouettes");
-    trade.repeats = 2;
-    const sampling::TradeResult result = sampling::run_trade(caster, &geometry, trade);
-
-    std::printf("\n== %s (%s, %s%s): feature mesh %zu triangles, iso", c.name.c_str(), c.volume.c_str(), c.tf.c_str(),
-                c.rotate_view ? ", view rotated 90 deg" : "", geometry.mesh.triangles.size());
-    for (double v : geometry.iso_values) std::printf(" %.1f", v);
-    std::printf(", view-independent setup %.0f ms (%zu triangles dropped at non-manifold vertices)\n",
-                geometry.build_ms, geometry.dropped_triangles);
-    std::printf("%s", sampling::trade_csv(result.rows).c_str());
-
-    const double full_ms = result.rows.front().total_ms;
-    std::printf("ratios                     FLIP_obj p/sub  (1-SSIM_obj) p/sub   FLIP_obj p/ctrl  (1-SSIM_obj) p/ctrl\n");
-    for (double f : trade.ray_fractions) {
-      const auto *p = find(result.rows, "prioritized", f), *s = find(result.rows, "subsample", f),
-                 *k = find(result.rows, "control", f);
-      std::printf("  fraction %.1f            %8.3f        %8.3f             %8.3f         %8.3f\n", f,
-                  p->object.flip / s->object.flip, (1 - p->object.ssim) / (1 - s->object.ssim),
-                  p->object.flip / k->object.flip, (1 - p->object.ssim) / (1 - k->object.ssim));
-    }
-    for (const char* mode : {"prioritized", "control", "subsample"}) {
-      const sampling::TradeRow* best = nullptr;
-      for (double f : trade.ray_fractions) {
-        const auto* r = find(result.rows, mode, f);
-        if (r->object.ssim >= 0.97) {
-          best = r;
-          break;
-        }
-      }
-      if (best)
-        std::printf("speed %-12s smallest fraction with SSIM_obj >= 0.97: %.1f, frame %.0f ms vs full %.0f ms = %.2fx\n",
-                    mode, best->ray_fraction, best->total_ms, full_ms, best->total_ms / full_ms);
-      else
-        std::printf("speed %-12s no fraction reaches SSIM_obj >= 0.97\n", mode);
-    }
-
-    if (c.name != "engine_opaque" || budget_frames < 1) continue;
-    // Budget mode: whole frames (importance + priorities + trace + reconstruction) against the budget.
-    std::printf("budget mode (%d frames each): budget_ms  p50_ms  p95_ms  p95/budget  mean_rays  level0_only\n",
-                budget_frames);
-    double reserve = -1;
-    for (double share : {0.1, 0.2, 0.4, 0.8}) {
-      sampling::SamplingOptions s;
-      s.mapping = mapping;
-      s.budget_ms = share * full_ms;
-      std::vector<double> times;
-      double rays = 0;
-      int level0_only = 0;
-      for (int k = 0; k < budget_frames; ++k) {
-        s.reconstruct_reserve_ms = reserve;  // the previous frame's measured reconstruction (x1.25), as in RP §5
-        const sampling::VolumeFrame frame = sampling::render_volume_frame(caster, &geometry, trade.features, s);
-        times.push_back(frame.total_ms);
-        rays += double(frame.sampled.rays_traced);
-        level0_only += frame.sampled.budget_too_small;
-        reserve = 1.25 * frame.sampled.reconstruct_ms;
-      }
-      const double p95 = percentile(times, 0.95);
-      std::printf("  %3.0f%% of full            %8.0f  %6.0f  %6.0f  %10.3f  %9.0f  %d\n", share * 100, s.budget_ms,
-                  percentile(times, 0.5), p95, p95 / s.budget_ms, rays / budget_frames, level0_only);
-    }
+    if (!listed(scenes, c.name)) continue;
+    Scene sc{c.name + " (" + c.volume + ", " + c.tf + (c.rotate_view ? ", view rotated 90 deg)" : ")"),
+             volume::load_vdb(dir + c.volume), volume::load_transfer_function(dir + c.tf), {}};
+    sc.camera = camera_spec_from_json(read_json_file(dir + c.camera), dir + c.camera);
+    if (c.rotate_view) sc.camera = rotated(sc.camera);
+    run_scene(sc, setup, width, height, c.name == "engine_opaque");
+  }
+  if (unseen) {
+    // Written once before any run, not tuned: a bright, mostly opaque smoke surface over its value range.
+    const std::string path = "/work/shared/datasets/openvdb_sample_smoke1_density_fog_111x222x112.vdb";
+    const volume::Volume vol = volume::load_vdb(path);
+    const volume::GridInfo info = vol.info();
+    volume::TfJsonOptions tf_options;
+    tf_options.normalized = true;
+    tf_options.data_min = info.value_min;
+    tf_options.data_max = info.value_max;
+    Scene sc{"unseen smoke (" + path + ")", vol,
+             volume::transfer_function_from_json(
+                 Json::parse(R"({"points": [[0,0,0,0,0],[0.1,0,0,0,0],[0.3,0.9,0.75,0.6,0.4],[0.6,1,0.95,0.85,0.9],)"
+                             R"([1,1,1,1,1]]})"),
+                 "bench smoke TF", tf_options),
+             {}};
+    sc.camera = box_camera(sc.vol);
+    run_scene(sc, setup, width, height, false);
   }
   return 0;
 }

@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <mutex>
 #include <string>
 
 #include "core/camera.h"
@@ -45,6 +46,13 @@ FractalPattern make_fractal_pattern(int width, int height, int base_spacing) {
   if (base_spacing < 1 || base_spacing > 128 || (base_spacing & (base_spacing - 1)) != 0)
     throw InvalidInput("fractal pattern: base spacing must be a power of two in 1..128, got " +
                        std::to_string(base_spacing));
+  // Every frame of a view size needs the same pattern: keep the last one (a pure function of its arguments).
+  static std::mutex mutex;
+  static FractalPattern last;
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (last.base_spacing == base_spacing && last.level.width == width && last.level.height == height) return last;
+  }
   FractalPattern pattern;
   pattern.base_spacing = base_spacing;
   pattern.num_levels = 1 + 2 * log2_exact(base_spacing);
@@ -53,6 +61,8 @@ FractalPattern make_fractal_pattern(int width, int height, int base_spacing) {
     for (int y = rows.begin(); y < rows.end(); ++y)
       for (int x = 0; x < width; ++x) pattern.level(x, y) = std::uint8_t(fractal_level(x, y, base_spacing));
   });
+  std::lock_guard<std::mutex> lock(mutex);
+  last = pattern;
   return pattern;
 }
 

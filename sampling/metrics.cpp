@@ -171,7 +171,7 @@ double mean_absolute_error(const ImageRGBA& a, const ImageRGBA& b, const ImageMa
   return n == 0 ? 0.0 : sum / double(n);
 }
 
-ImageF ssim_map(const ImageRGBA& a, const ImageRGBA& b) {
+ImageF ssim_map(const ImageRGBA& a, const ImageRGBA& b, SsimSignal signal) {
   require_same_size(a, b, nullptr);
   constexpr int kRadius = 5;
   constexpr double kSigma = 1.5, kC1 = (0.01 * 255) * (0.01 * 255), kC2 = (0.03 * 255) * (0.03 * 255);
@@ -184,7 +184,11 @@ ImageF ssim_map(const ImageRGBA& a, const ImageRGBA& b) {
   for (int i = -kRadius; i <= kRadius; ++i) weight_sum += weights[i + kRadius] = std::exp(-i * i / (2 * kSigma * kSigma));
   for (double& v : weights) v /= weight_sum;  // the 2D window is the outer product, so it also sums to 1
 
-  auto luma = [](const Rgba& p) {
+  auto luma = [signal](const Rgba& p) {
+    if (signal == SsimSignal::LinearLuminance) {
+      auto c = [](float v) { return double(std::min(1.0f, std::max(0.0f, v))); };
+      return 255.0 * (0.2126 * c(p.r) + 0.7152 * c(p.g) + 0.0722 * c(p.b));
+    }
     const auto s = display_rgb(p);
     return 255.0 * (0.299 * s[0] + 0.587 * s[1] + 0.114 * s[2]);
   };
@@ -408,12 +412,13 @@ Comparison compare_images(const ImageRGBA& reference, const ImageRGBA& test, con
   Comparison result;
   result.flip_map = flip_map(reference, test, options.flip_ppd);
   const ImageF ssim = ssim_map(reference, test);
+  const ImageF ssim_linear = ssim_map(reference, test, SsimSignal::LinearLuminance);
 
   // Means in double, serially, so the result does not depend on the thread count.
   auto fill = [&](ImageMetrics& m, const ImageMask* sel) {
     m.psnr = psnr(reference, test, sel);
     m.mae = mean_absolute_error(reference, test, sel);
-    double flip_sum = 0, ssim_sum = 0;
+    double flip_sum = 0, ssim_sum = 0, ssim_linear_sum = 0;
     std::size_t count = 0, ssim_count = 0;
     for (std::size_t i = 0; i < reference.size(); ++i) {
       if (!selected(sel, i)) continue;
@@ -421,6 +426,7 @@ Comparison compare_images(const ImageRGBA& reference, const ImageRGBA& test, con
       ++count;
       if (!std::isnan(ssim.pixels[i])) {
         ssim_sum += ssim.pixels[i];
+        ssim_linear_sum += ssim_linear.pixels[i];
         ++ssim_count;
       }
     }
@@ -428,6 +434,7 @@ Comparison compare_images(const ImageRGBA& reference, const ImageRGBA& test, con
     m.flip = count ? flip_sum / double(count) : 0.0;
     // An object entirely within the 5-pixel border has no full SSIM window: report 1 only if identical.
     m.ssim = ssim_count ? ssim_sum / double(ssim_count) : (m.mae == 0 ? 1.0 : 0.0);
+    m.ssim_linear = ssim_count ? ssim_linear_sum / double(ssim_count) : (m.mae == 0 ? 1.0 : 0.0);
   };
   fill(result.frame, nullptr);
   fill(result.object, &mask);
@@ -438,6 +445,7 @@ void add_metrics_json(Json& json, const ImageMetrics& metrics, const std::string
   auto value = [&](double v) { return metrics.pixels == 0 ? Json(nullptr) : Json(v); };
   json["psnr" + suffix] = value(metrics.psnr);
   json["ssim" + suffix] = value(metrics.ssim);
+  json["ssim_linear" + suffix] = value(metrics.ssim_linear);
   json["mae" + suffix] = value(metrics.mae);
   json["flip" + suffix] = value(metrics.flip);
 }

@@ -24,6 +24,8 @@ double default_flip_ppd();
 struct ImageMetrics {
   double psnr = 0;  ///< dB over RGB sRGB values in [0,1] (MAX = 1), capped at kPsnrCapDb
   double ssim = 0;  ///< mean SSIM over the valid region (5-pixel border dropped) within the set
+  /// The same SSIM on linear luminance (SsimSignal::LinearLuminance), so a result cannot hinge on the gamma.
+  double ssim_linear = 0;
   double mae = 0;   ///< mean |a-b| over RGB sRGB values in [0,1]
   double flip = 0;  ///< mean LDR-FLIP error in [0,1]
   std::size_t pixels = 0;
@@ -55,14 +57,16 @@ Comparison compare_images(const ImageRGBA& reference, const ImageRGBA& test, con
 double psnr(const ImageRGBA& a, const ImageRGBA& b, const ImageMask* mask = nullptr);
 /// Mean absolute error over the selected pixels' RGB sRGB values in [0,1].
 double mean_absolute_error(const ImageRGBA& a, const ImageRGBA& b, const ImageMask* mask = nullptr);
-/// Per-pixel SSIM on luma Y' = 0.299R'+0.587G'+0.114B' of the sRGB values scaled to 0..255; Gaussian
-/// 11x11 window, sigma 1.5, K1 = 0.01, K2 = 0.03, L = 255. Pixels within 5 of the border have no full
-/// window and are set to NaN (they are excluded from every mean).
-ImageF ssim_map(const ImageRGBA& a, const ImageRGBA& b);
+/// What SSIM compares: luma Y' = 0.299R'+0.587G'+0.114B' of the sRGB values (the default, as most
+/// image tools), or linear luminance Y = 0.2126R+0.7152G+0.0722B of the linear values clamped to [0,1].
+enum class SsimSignal { SrgbLuma, LinearLuminance };
+/// Per-pixel SSIM on `signal` scaled to 0..255; Gaussian 11x11 window, sigma 1.5, K1 = 0.01, K2 = 0.03,
+/// L = 255. Pixels within 5 of the border have no full window and are set to NaN (excluded from every mean).
+ImageF ssim_map(const ImageRGBA& a, const ImageRGBA& b, SsimSignal signal = SsimSignal::SrgbLuma);
 /// Per-pixel LDR-FLIP error in [0,1] (0 = identical), reference first.
 ImageF flip_map(const ImageRGBA& reference, const ImageRGBA& test, double ppd = default_flip_ppd());
 
-/// Keys psnr, ssim, mae, flip (+ `suffix`), null for an empty pixel set.
+/// Keys psnr, ssim, ssim_linear, mae, flip (+ `suffix`), null for an empty pixel set.
 void add_metrics_json(Json& json, const ImageMetrics& metrics, const std::string& suffix);
 
 }  // namespace raysift::sampling

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <mutex>
 
 #include "core/errors.h"
 #include "sampling/reconstruction.h"
@@ -53,9 +55,68 @@ void trace_selection(const ImageMask& selected, const TraceBatch& trace, Sampled
   frame.rays_traced = rays.size();
 }
 
+// The counts without building the pattern (the subsample and full modes do not need it).
+ObjectCounts count_object_pixels(const ImageF& importance, int spacing) {
+  ObjectCounts c;
+  for (int y = 0; y < importance.height; ++y)
+    for (int x = 0; x < importance.width; ++x) {
+      if (importance(x, y) < 0) continue;
+      ++c.object;
+      c.level0 += x % spacing == 0 && y % spacing == 0 ? 1 : 0;
+    }
+  return c;
+}
+
 std::size_t ray_target(const SamplingOptions& options, std::size_t object, std::size_t level0) {
   const auto wanted = std::size_t(std::llround(options.ray_fraction * double(object)));
   return std::min(object, std::max(level0, wanted));
+}
+
+
+double reconstruct_reserve(const SamplingOptions& options, int w, int h) {
+  return options.reconstruct_reserve_ms >= 0 ? options.reconstruct_reserve_ms
+                                             : estimate_reconstruct_ms(w, h, options.base_spacing);
+}
+
+// Budget mode with the a priori bucketed queue (RP paper section 5).
+void trace_budgeted_queue(const ImageF& importance, const FractalPattern& pattern, const SamplingOptions& options,
+                          const TraceBatch& trace, const ElapsedMs& now, double elapsed_before_ms,
+                          SampledFrame& frame, Timer& stage) {
+  const RayQueue queue = make_bucketed_queue(importance, pattern, options.mapping, options.buckets, options.seed);
+  frame.priorities_ms = stage.elapsed_ms();
+  const double reserve = reconstruct_reserve(options, importance.width, importance.height);
+  stage.reset();
+  const Span<const std::uint32_t> all(queue.pixels.data(), queue.pixels.size());
+  trace_all(Span<const std::uint32_t>(all.data(), queue.level0_count), trace, frame.image);
+  const double deadline = options.budget_ms - elapsed_before_ms - reserve;
+  frame.budget_too_small = now() > deadline;
+  const std::size_t more = trace_until(
+      Span<const std::uint32_t>(all.data() + queue.level0_count, all.size() - queue.level0_count), trace,
+      frame.image, now, deadline);
+  frame.rays_traced = queue.level0_count + more;
+  frame.trace_ms = stage.elapsed_ms();
+  mark(Span<const std::uint32_t>(queue.pixels.data(), frame.rays_traced), frame.traced);
+}
+
+// Fraction or budget mode with a posteriori refinement; the priorities are computed inside the trace rounds
+// and counted as trace time.
+void trace_refined_frame(const ImageF& importance, const FractalPattern& pattern, const SamplingOptions& options,
+                         const TraceBatch& trace, std::size_t target, const ElapsedMs& now,
+                         double elapsed_before_ms, SampledFrame& frame, Timer& stage) {
+  RefinementStop stop;
+  stop.rays = target;
+  if (options.budget_ms > 0) {
+    stop.deadline_ms = options.budget_ms - elapsed_before_ms - reconstruct_reserve(options, importance.width,
+                                                                                  importance.height);
+    stop.now = &now;
+  }
+  frame.priorities_ms = stage.elapsed_ms();
+  stage.reset();
+  const RefinementResult r =
+      trace_refined(importance, pattern, options.refinement, stop, options.seed, trace, frame.image, frame.traced);
+  frame.trace_ms = stage.elapsed_ms();
+  frame.rays_traced = r.rays;
+  frame.budget_too_small = r.level0_overran;
 }
 
 }  // namespace
@@ -96,14 +157,22 @@ ImageF control_importance(const ImageF& importance) {
 }
 
 double estimate_reconstruct_ms(int width, int height, int base_spacing) {
-  const int cw = std::min(width, 512), ch = std::min(height, 512);
-  const FractalPattern pattern = make_fractal_pattern(cw, ch, base_spacing);
-  ImageMask known(cw, ch, 0);
-  for (std::size_t i = 0; i < known.size(); ++i) known.pixels[i] = pattern.level.pixels[i] == 0 ? 1 : 0;
-  ImageRGBA image(cw, ch);
-  const Timer timer;
-  reconstruct_fractal(image, known, pattern);
-  return timer.elapsed_ms() * double(width) * double(height) / (double(cw) * double(ch));
+  // Measured once per (crop, spacing) and process: the estimate must not cost a reconstruction per frame.
+  static std::mutex mutex;
+  static std::map<std::pair<int, int>, double> ms_per_pixel;  // key (crop side, spacing)
+  const int side = std::min(256, std::max(16, std::min(width, height)));
+  std::lock_guard<std::mutex> lock(mutex);
+  auto it = ms_per_pixel.find({side, base_spacing});
+  if (it == ms_per_pixel.end()) {
+    const FractalPattern pattern = make_fractal_pattern(side, side, base_spacing);
+    ImageMask known(side, side, 0);
+    for (std::size_t i = 0; i < known.size(); ++i) known.pixels[i] = pattern.level.pixels[i] == 0 ? 1 : 0;
+    ImageRGBA image(side, side);
+    const Timer timer;
+    reconstruct_fractal(image, known, pattern);
+    it = ms_per_pixel.emplace(std::make_pair(side, base_spacing), timer.elapsed_ms() / double(side * side)).first;
+  }
+  return it->second * double(width) * double(height);
 }
 
 SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, const SamplingOptions& options,
@@ -118,8 +187,7 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
   frame.traced = ImageMask(w, h, 0);
 
   Timer stage;
-  const FractalPattern pattern = make_fractal_pattern(w, h, options.base_spacing);
-  const ObjectCounts counts = count_object_pixels(importance, pattern);
+  const ObjectCounts counts = count_object_pixels(importance, options.base_spacing);
   frame.full_rays = counts.object;
   frame.level0_rays = counts.level0;
   const std::size_t target = ray_target(options, counts.object, counts.level0);
@@ -143,25 +211,14 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
     return frame;
   }
 
-  RayQueue queue;
-  if (options.budget_ms > 0) {
-    queue = make_bucketed_queue(importance, pattern, options.mapping, options.buckets, options.seed);
-    frame.priorities_ms = stage.elapsed_ms();
-    const double reserve = options.reconstruct_reserve_ms >= 0 ? options.reconstruct_reserve_ms
-                                                                : estimate_reconstruct_ms(w, h, options.base_spacing);
-    stage.reset();
-    const Span<const std::uint32_t> all(queue.pixels.data(), queue.pixels.size());
-    trace_all(Span<const std::uint32_t>(all.data(), queue.level0_count), trace, frame.image);
-    const double deadline = options.budget_ms - elapsed_before_ms - reserve;
-    frame.budget_too_small = now() > deadline;
-    const std::size_t more = trace_until(Span<const std::uint32_t>(all.data() + queue.level0_count,
-                                                                   all.size() - queue.level0_count),
-                                         trace, frame.image, now, deadline);
-    frame.rays_traced = queue.level0_count + more;
-    frame.trace_ms = stage.elapsed_ms();
-    mark(Span<const std::uint32_t>(queue.pixels.data(), frame.rays_traced), frame.traced);
+  const FractalPattern pattern = make_fractal_pattern(w, h, options.base_spacing);
+  if (options.refinement.enabled && !std::isfinite(options.threshold)) {
+    trace_refined_frame(importance, pattern, options, trace, target, now, elapsed_before_ms, frame, stage);
+  } else if (options.budget_ms > 0) {
+    trace_budgeted_queue(importance, pattern, options, trace, now, elapsed_before_ms, frame, stage);
   } else {
-    queue = select_top_rays(importance, pattern, options.mapping, target, options.seed, options.threshold);
+    const RayQueue queue =
+        select_top_rays(importance, pattern, options.mapping, target, options.seed, options.threshold);
     ImageMask selected(w, h, 0);
     mark(queue.pixels, selected);
     trace_selection(selected, trace, frame, stage);
@@ -171,7 +228,7 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
   if (frame.rays_traced < counts.object) {
     ImageMask known = background_known(importance);
     for (std::size_t i = 0; i < known.size(); ++i) known.pixels[i] |= frame.traced.pixels[i];
-    reconstruct_fractal(frame.image, known, pattern);
+    reconstruct_fractal(frame.image, known, pattern, options.interpolation);
   }
   frame.reconstruct_ms = stage.elapsed_ms();
   return frame;
@@ -230,7 +287,7 @@ SampledFrame ProgressiveSampler::next_frame(const TraceBatch& trace) {
   frame.rays_traced = next_;
   stage.reset();
   frame.image = samples_;
-  if (!converged()) reconstruct_fractal(frame.image, known_, pattern_);
+  if (!converged()) reconstruct_fractal(frame.image, known_, pattern_, options_.interpolation);
   frame.reconstruct_ms = stage.elapsed_ms();
   last_reconstruct_ms_ = frame.reconstruct_ms;
   return frame;

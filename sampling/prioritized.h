@@ -12,6 +12,7 @@
 #include "sampling/fractal_pattern.h"
 #include "sampling/image_mask.h"
 #include "sampling/ray_order.h"
+#include "sampling/refinement.h"
 #include "sampling/scheduler.h"
 
 namespace raysift::sampling {
@@ -34,7 +35,11 @@ struct SamplingOptions {
   double budget_ms = 0;
   /// Budget mode: time kept for reconstruction (ms); < 0 = measured on a calibration crop.
   double reconstruct_reserve_ms = -1;
-  PriorityMapping mapping;
+  PriorityMapping mapping;  ///< the a priori queue (refinement off, threshold and progressive modes)
+  /// Prioritized fraction and budget modes: place rays from the traced level-0 samples (refinement.h).
+  RefinementOptions refinement;
+  /// How the prioritized modes fill untraced pixels (reconstruction.h).
+  Interpolation interpolation = Interpolation::Cubic;
   int base_spacing = 8;   ///< fractal level-0 spacing, px (power of two)
   int buckets = 256;      ///< priority buckets of the budget/progressive queue
   std::uint64_t seed = 1;
@@ -70,7 +75,7 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
                             double elapsed_before_ms = 0);
 
 /// \brief Wall time of one fractal reconstruction of a frame of this size with only level 0 traced
-/// (the worst case), measured on a crop of at most 512x512 and scaled by area.
+/// (the worst case), measured once per process on a crop of at most 256x256 and scaled by area.
 double estimate_reconstruct_ms(int width, int height, int base_spacing);
 
 /// \brief Progressive refinement for a static camera (RP paper section 5): each frame continues the

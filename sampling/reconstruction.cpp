@@ -76,38 +76,129 @@ bool cell_corners(int x, int y, int state, int spacing, int w, int h, std::array
   return true;
 }
 
+
+Rgba mean_of(const ImageRGBA& image, const std::array<Corner, 4>& corners, int n) {
+  Rgba sum;
+  for (int i = 0; i < n; ++i) {
+    const Rgba& p = image(corners[i].x, corners[i].y);
+    sum = {sum.r + p.r, sum.g + p.g, sum.b + p.b, sum.a + p.a};
+  }
+  const float inv = 1.0f / float(n);
+  return clamp01({sum.r * inv, sum.g * inv, sum.b * inv, sum.a * inv});
+}
+
+// Coarse to fine over square cells of spacing s = S, S/2, ..., 2 whose corners are available: the centre
+// gets the mean of the corners, then each edge midpoint the mean of its two ends, or, where both squares
+// beside it have a traced centre, the mean of those four diamond parents. Midpoint averaging evaluates the
+// bilinear interpolant at the dyadic points, so a flat region gets exactly the bilinear cell of its finest
+// complete lattice, and traced pixels of finer levels feed the cells below them without seams. O(1) per pixel.
+// The 4-point interpolatory midpoint rule (Dubuc / Deslauriers-Dubuc): exact for cubics, so for affine
+// images too; clamped to the two inner taps' range per channel, so an edge does not ring.
+constexpr std::array<float, 4> kCubicMid{-1.0f / 16, 9.0f / 16, 9.0f / 16, -1.0f / 16};
+
+Rgba clamp_between(Rgba v, const Rgba& a, const Rgba& b) {
+  auto c = [](float x, float p, float q) { return std::min(std::max(p, q), std::max(std::min(p, q), x)); };
+  return {c(v.r, a.r, b.r), c(v.g, a.g, b.g), c(v.b, a.b, b.b), c(v.a, a.a, b.a)};
+}
+
+// Cubic value at (x, y) from the s-lattice taps x + (2i-3) dx.. along one axis (dx, dy) = the half step,
+// or false if a tap is missing.
+bool cubic_1d(const ImageRGBA& image, const ImageMask& available, int x, int y, int dx, int dy, Rgba& out) {
+  std::array<Corner, 4> taps;
+  for (int i = 0; i < 4; ++i) {
+    const int tx = x + (2 * i - 3) * dx, ty = y + (2 * i - 3) * dy;
+    if (tx < 0 || ty < 0 || tx >= image.width || ty >= image.height || !available(tx, ty)) return false;
+    taps[i] = {tx, ty, kCubicMid[i]};
+  }
+  out = clamp_between(weighted_sum(image, taps), image(taps[1].x, taps[1].y), image(taps[2].x, taps[2].y));
+  return true;
+}
+
+// Cubic centre of the square (x0, y0)-(x0+s, y0+s): the tensor rule over the 4x4 lattice around it.
+bool cubic_centre(const ImageRGBA& image, const ImageMask& available, int x0, int y0, int s, Rgba& out) {
+  if (x0 - s < 0 || y0 - s < 0 || x0 + 2 * s >= image.width || y0 + 2 * s >= image.height) return false;
+  Rgba sum;
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i) {
+      const int x = x0 + (i - 1) * s, y = y0 + (j - 1) * s;
+      if (!available(x, y)) return false;
+      const float wgt = kCubicMid[i] * kCubicMid[j];
+      const Rgba& p = image(x, y);
+      sum = {sum.r + wgt * p.r, sum.g + wgt * p.g, sum.b + wgt * p.b, sum.a + wgt * p.a};
+    }
+  const Rgba& a = image(x0, y0);
+  const Rgba& b = image(x0 + s, y0 + s);
+  const Rgba& c = image(x0 + s, y0);
+  const Rgba& d = image(x0, y0 + s);
+  const Rgba lo{std::min({a.r, b.r, c.r, d.r}), std::min({a.g, b.g, c.g, d.g}), std::min({a.b, b.b, c.b, d.b}),
+                std::min({a.a, b.a, c.a, d.a})};
+  const Rgba hi{std::max({a.r, b.r, c.r, d.r}), std::max({a.g, b.g, c.g, d.g}), std::max({a.b, b.b, c.b, d.b}),
+                std::max({a.a, b.a, c.a, d.a})};
+  out = clamp_between(sum, lo, hi);
+  return true;
+}
+
+// Coarse to fine over square cells of spacing s = S, S/2, ..., 2 whose corners are available: the centre
+// gets the mean of the corners, then each edge midpoint the mean of its two ends, or, where both squares
+// beside it have a traced centre, the mean of those four diamond parents. Midpoint averaging evaluates the
+// bilinear interpolant at the dyadic points, so a flat region gets exactly the bilinear cell of its finest
+// complete lattice, and traced pixels of finer levels feed the cells below them without seams. With
+// Interpolation::Cubic the 4-point rule replaces the means wherever its wider stencil is available.
+// O(1) per pixel.
+void fill_hierarchically(ImageRGBA& image, const ImageMask& known, ImageMask& available, int spacing,
+                         Interpolation interpolation) {
+  const int w = image.width, h = image.height;
+  const bool cubic = interpolation == Interpolation::Cubic;
+  for (int s = spacing; s >= 2; s /= 2) {
+    const int g = s / 2, cell_rows = (h - 1) / s;
+    parallel_rows(cell_rows, [&](int r) {
+      const int y0 = r * s;
+      for (int x0 = 0; x0 + s < w; x0 += s) {
+        if (available(x0 + g, y0 + g)) continue;
+        const std::array<Corner, 4> c{Corner{x0, y0, 0}, Corner{x0 + s, y0, 0}, Corner{x0, y0 + s, 0},
+                                      Corner{x0 + s, y0 + s, 0}};
+        bool complete = true;
+        for (const Corner& k : c) complete = complete && available(k.x, k.y);
+        if (!complete) continue;
+        Rgba& out = image(x0 + g, y0 + g);
+        if (!cubic || !cubic_centre(image, available, x0, y0, s, out)) out = mean_of(image, c, 4);
+        available(x0 + g, y0 + g) = 1;
+      }
+    });
+    // Edge midpoints: row 2r holds horizontal edges (y = r s), row 2r+1 vertical ones (y = r s + g).
+    auto traced_centre = [&](int x, int y) { return x >= 0 && y >= 0 && x < w && y < h && known(x, y); };
+    parallel_rows(2 * cell_rows + 1, [&](int r) {
+      const bool horizontal = r % 2 == 0;
+      const int y = (r / 2) * s + (horizontal ? 0 : g);
+      for (int x = horizontal ? g : 0; x < w; x += s) {
+        if (available(x, y)) continue;
+        const int dx = horizontal ? g : 0, dy = horizontal ? 0 : g;
+        if (x - dx < 0 || x + dx >= w || y - dy < 0 || y + dy >= h) continue;
+        if (!available(x - dx, y - dy) || !available(x + dx, y + dy)) continue;
+        std::array<Corner, 4> c{Corner{x - dx, y - dy, 0}, Corner{x + dx, y + dy, 0}, Corner{x - dy, y - dx, 0},
+                                Corner{x + dy, y + dx, 0}};
+        const bool diamond = traced_centre(c[2].x, c[2].y) && traced_centre(c[3].x, c[3].y);
+        Rgba& out = image(x, y);
+        if (diamond || !cubic || !cubic_1d(image, available, x, y, dx, dy, out)) out = mean_of(image, c, diamond ? 4 : 2);
+        available(x, y) = 1;
+      }
+    });
+  }
+}
+
 }  // namespace
 
-void reconstruct_fractal(ImageRGBA& image, const ImageMask& known, const FractalPattern& pattern) {
+void reconstruct_fractal(ImageRGBA& image, const ImageMask& known, const FractalPattern& pattern,
+                         Interpolation interpolation) {
   const int w = image.width, h = image.height, spacing = pattern.base_spacing;
   RAYSIFT_CHECK(known.width == w && known.height == h);
   RAYSIFT_CHECK(pattern.level.width == w && pattern.level.height == h);
 
-  // Pass 1: complete anchors whose four parents were traced. Reads only `known` pixels, writes only
-  // unknown ones, so rows are independent.
   ImageMask available = known;
-  parallel_rows(h, [&](int y) {
-    for (int x = 0; x < w; ++x) {
-      if (known(x, y)) continue;
-      const int level = pattern.level(x, y);
-      const int d = parent_offset(level, spacing);
-      std::array<Corner, 4> parents;
-      if (level % 2 == 1)
-        parents = {Corner{x - d, y - d, 0.25f}, Corner{x + d, y - d, 0.25f}, Corner{x - d, y + d, 0.25f},
-                   Corner{x + d, y + d, 0.25f}};
-      else
-        parents = {Corner{x - d, y, 0.25f}, Corner{x + d, y, 0.25f}, Corner{x, y - d, 0.25f},
-                   Corner{x, y + d, 0.25f}};
-      bool complete = true;
-      for (const Corner& c : parents)
-        complete = complete && c.x >= 0 && c.y >= 0 && c.x < w && c.y < h && known(c.x, c.y);
-      if (!complete) continue;
-      image(x, y) = weighted_sum(image, parents);
-      available(x, y) = 1;
-    }
-  });
+  fill_hierarchically(image, known, available, spacing, interpolation);
 
-  // Pass 2: interpolate the rest from the finest complete cell. Reads only `available` pixels.
+  // Pass 2: what the hierarchy could not reach (cells crossing the right/bottom border, missing level-0
+  // pixels) from the finest complete cell. Reads only `available` pixels.
   parallel_rows(h, [&](int y) {
     for (int x = 0; x < w; ++x) {
       if (available(x, y)) continue;

@@ -20,7 +20,12 @@ namespace raysift::sampling {
 /// \pre image, known and pattern.level have the same size. Level-0 pixels should all be known; where
 ///      they are not, pixels without any complete cell keep the mean of the known corners found (or 0).
 /// Output values are clamped to [0,1].
-void reconstruct_fractal(ImageRGBA& image, const ImageMask& known, const FractalPattern& pattern);
+/// Linear: bilinear cells (the RP paper's rule); Cubic: the 4-point interpolatory rule where its stencil is
+/// available, clamped to the cell's corner range (sharper shading, no ringing at edges).
+enum class Interpolation { Linear, Cubic };
+
+void reconstruct_fractal(ImageRGBA& image, const ImageMask& known, const FractalPattern& pattern,
+                         Interpolation interpolation = Interpolation::Linear);
 
 /// A regular sampling grid for the subsample baseline: pixel columns xs and rows ys (increasing).
 struct SampleGrid {

@@ -116,8 +116,12 @@ TEST(FractalReconstruction, AffineImageExactFromEveryLevelPrefix) {
             known(x, y) = 1;
             image(x, y) = affine(x, y);
           }
-      reconstruct_fractal(image, known, p);
-      expect_affine(image, std::to_string(w) + "x" + std::to_string(h) + " prefix " + std::to_string(state));
+      for (Interpolation mode : {Interpolation::Linear, Interpolation::Cubic}) {
+        ImageRGBA filled = image;
+        reconstruct_fractal(filled, known, p, mode);
+        expect_affine(filled, std::to_string(w) + "x" + std::to_string(h) + " prefix " + std::to_string(state) +
+                                  (mode == Interpolation::Cubic ? " cubic" : " linear"));
+      }
     }
   }
 }
@@ -136,8 +140,11 @@ TEST(FractalReconstruction, AffineImageExactFromRandomSubsetsWithLevelZero) {
           known(x, y) = 1;
           image(x, y) = affine(x, y);
         }
-    reconstruct_fractal(image, known, p);
-    expect_affine(image, "keep " + std::to_string(keep));
+    for (Interpolation mode : {Interpolation::Linear, Interpolation::Cubic}) {
+      ImageRGBA filled = image;
+      reconstruct_fractal(filled, known, p, mode);
+      expect_affine(filled, "keep " + std::to_string(keep) + (mode == Interpolation::Cubic ? " cubic" : " linear"));
+    }
   }
 }
 

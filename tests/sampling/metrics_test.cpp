@@ -115,6 +115,19 @@ TEST(Metrics, SsimOfConstantShiftIsTheLuminanceTerm) {
   EXPECT_NEAR(compare_images(a, b).frame.ssim, (2.0 * ya * yb + c1) / (ya * ya + yb * yb + c1), 1e-4);
 }
 
+TEST(Metrics, LinearLuminanceSsimOfConstantShiftIsTheLuminanceTerm) {
+  // Linear luminance of grey g is g itself: mu = 255 g, and the sRGB SSIM of the same pair differs.
+  const double ga = 0.2, gb = 0.25;
+  const ImageRGBA a = constant_image(20, 20, float(ga), float(ga), float(ga));
+  const ImageRGBA b = constant_image(20, 20, float(gb), float(gb), float(gb));
+  const double ya = 255 * ga, yb = 255 * gb, c1 = 6.5025;
+  const Comparison c = compare_images(a, b);
+  // 1e-6: float inputs, double arithmetic.
+  EXPECT_NEAR(c.frame.ssim_linear, (2.0 * ya * yb + c1) / (ya * ya + yb * yb + c1), 1e-6);
+  EXPECT_GT(std::fabs(c.frame.ssim_linear - c.frame.ssim), 1e-3) << "the two signals must differ for a mid grey";
+  EXPECT_EQ(compare_images(a, a).object.ssim_linear, 1.0);
+}
+
 TEST(Metrics, FlipOfUniformShiftIsTheColourTerm) {
   // Uniform images have no edges or points, so FLIP reduces to the remapped HyAB^0.7 colour distance
   // of the two colours (the filters preserve constants).

@@ -73,6 +73,12 @@ SamplingOptions options_for(SamplingMode mode, double fraction) {
   return o;
 }
 
+// The RP paper's a priori queue (refinement off): what the top-N, bucket and importance tests are about.
+SamplingOptions a_priori(SamplingOptions o) {
+  o.refinement.enabled = false;
+  return o;
+}
+
 float priority_of(const ImageF& imp, const FractalPattern& p, std::size_t i, const PriorityMapping& m) {
   return ray_priority(imp.pixels[i], pattern_priority(p.level.pixels[i], p.num_levels), m);
 }
@@ -127,7 +133,7 @@ TEST(SampledFrame, FractionOneReproducesFullRenderBitExactly) {
 
 TEST(SampledFrame, ThresholdModeTracesExactlyTheTopRays) {
   const ImageF imp = disc_importance();
-  const SamplingOptions o = options_for(SamplingMode::Prioritized, 0.3);
+  const SamplingOptions o = a_priori(options_for(SamplingMode::Prioritized, 0.3));
   MockTracer mock(imp.size());
   const SampledFrame frame = render_sampled(imp, mock.batch(), o);
   const FractalPattern p = make_fractal_pattern(kW, kH, 8);
@@ -163,7 +169,7 @@ TEST(SampledFrame, PriorityThresholdSelectsByValue) {
 
 TEST(SampledFrame, BudgetStopsLaunchingAtDeadlineInPriorityOrder) {
   const ImageF imp = disc_importance();
-  SamplingOptions o = options_for(SamplingMode::Prioritized, 1.0);
+  SamplingOptions o = a_priori(options_for(SamplingMode::Prioritized, 1.0));
   o.budget_ms = 40;
   o.reconstruct_reserve_ms = 5;
   // 20 us per ray: the 11k object rays would take ~230 ms of (virtual) work, far beyond the budget.
@@ -246,9 +252,9 @@ TEST(SampledFrame, ImportanceBeatsControlOnAFeatureImage) {
       if (imp.pixels[i] >= 0) e += std::fabs(image.pixels[i].r - sharp(std::uint32_t(i)).r);
     return e;
   };
-  const double prioritized = error(render_sampled(imp, trace, options_for(SamplingMode::Prioritized, 0.3)).image);
-  const double control =
-      error(render_sampled(control_importance(imp), trace, options_for(SamplingMode::Prioritized, 0.3)).image);
+  const SamplingOptions o = a_priori(options_for(SamplingMode::Prioritized, 0.3));
+  const double prioritized = error(render_sampled(imp, trace, o).image);
+  const double control = error(render_sampled(control_importance(imp), trace, o).image);
   EXPECT_LT(prioritized, 0.8 * control);
 }
 

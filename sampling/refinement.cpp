@@ -1,0 +1,283 @@
+#include "sampling/refinement.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include "core/errors.h"
+#include "core/timer.h"
+#include "sampling/ray_order.h"
+
+namespace raysift::sampling {
+namespace {
+
+// Below this a round's parallel trace does not amortise its start-up; above it the priorities react late.
+constexpr std::size_t kMinRound = 256;
+
+// Priorities are kept in log-spaced buckets (kBucketsPerOctave per factor 2) instead of a heap: O(1) per
+// candidate, and first-in first-out inside a bucket, which is deterministic because candidates are offered
+// serially in a fixed order.
+constexpr int kBucketsPerOctave = 16, kBuckets = 24 * kBucketsPerOctave;
+
+int bucket_of(float priority) {
+  const int b = int(std::floor(-std::log2(std::max(priority, 1e-30f)) * float(kBucketsPerOctave)));
+  return std::min(kBuckets - 1, std::max(0, b + 2 * kBucketsPerOctave));  // priorities up to 4 get bucket >= 0
+}
+
+// Sorts [first, last) by key(pixel), each key computed once (the keys hash, so a comparator would rehash).
+template <typename It, typename Key>
+void sort_by_key(It first, It last, const Key& key) {
+  std::vector<std::uint64_t> keyed;
+  keyed.reserve(std::size_t(last - first));
+  for (It it = first; it != last; ++it) keyed.push_back(key(*it));
+  std::sort(keyed.begin(), keyed.end());
+  for (std::uint64_t k : keyed) *first++ = std::uint32_t(k & 0xFFFFFFFFu);
+}
+
+class BucketQueue {
+ public:
+  explicit BucketQueue(std::uint64_t seed) : buckets_(kBuckets), seed_(seed) {}
+  void push(float priority, std::uint32_t pixel) {
+    const int b = bucket_of(priority);
+    buckets_[b].push_back(pixel);
+    top_ = std::min(top_, b);
+    ++size_;
+  }
+  // Up to `count` pixels, highest buckets first. A bucket's waiting pixels are served in hashed order,
+  // not in the (scan) order they were offered in, so a bucket cut short is spread over the frame.
+  std::vector<std::uint32_t> pop(std::size_t count) {
+    std::vector<std::uint32_t> out;
+    out.reserve(std::min(count, size_));
+    while (out.size() < count && size_ > 0) {
+      std::vector<std::uint32_t>& bucket = buckets_[top_];
+      std::size_t& next = next_[top_];
+      if (next == bucket.size()) {
+        ++top_;
+        continue;
+      }
+      // Each entry is sorted once: those offered since the bucket was last served, among themselves.
+      std::size_t& sorted = sorted_[top_];
+      if (sorted < bucket.size()) {
+        const std::size_t from = std::max(sorted, next);
+        sort_by_key(bucket.begin() + std::ptrdiff_t(from), bucket.end(),
+                    [this](std::uint32_t p) { return std::uint64_t(pixel_hash(p, seed_)) << 32 | p; });
+        sorted = bucket.size();
+      }
+      const std::size_t take = std::min(count - out.size(), bucket.size() - next);
+      out.insert(out.end(), bucket.begin() + std::ptrdiff_t(next), bucket.begin() + std::ptrdiff_t(next + take));
+      next += take;
+      size_ -= take;
+    }
+    return out;
+  }
+  std::size_t size() const { return size_; }
+
+ private:
+  std::vector<std::vector<std::uint32_t>> buckets_;
+  std::array<std::size_t, kBuckets> next_{}, sorted_{};
+  std::uint64_t seed_;
+  int top_ = kBuckets - 1;
+  std::size_t size_ = 0;
+};
+
+// Offsets from a pixel of `level` >= 1 to its parents, and (negated) from a parent to its children there.
+std::array<std::array<int, 2>, 4> parent_offsets(int level, int spacing) {
+  const int d = parent_offset(level, spacing);
+  if (level % 2 == 1) return {{{-d, -d}, {d, -d}, {-d, d}, {d, d}}};
+  return {{{-d, 0}, {d, 0}, {0, -d}, {0, d}}};
+}
+
+class Refiner {
+ public:
+  Refiner(const ImageF& importance, const FractalPattern& pattern, const RefinementOptions& options,
+          std::uint64_t seed, ImageRGBA& image, ImageMask& traced)
+      : imp_(importance), pattern_(pattern), options_(options), image_(image), traced_(traced),
+        taken_(importance.width, importance.height, 0), offered_(importance.width, importance.height, 0.0f),
+        percept_(importance.width, importance.height, std::array<std::uint8_t, 4>{}),
+        queue_(seed) {}
+
+  bool known(int x, int y) const { return imp_(x, y) < 0 || traced_(x, y); }
+
+  // Candidates no traced parent will offer: every in-image parent is background.
+  void offer_orphans() {
+    for (int y = 0; y < imp_.height; ++y)
+      for (int x = 0; x < imp_.width; ++x) {
+        const int level = pattern_.level(x, y);
+        if (level == 0 || imp_(x, y) < 0) continue;
+        bool orphan = true;
+        for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
+          const int px = x + o[0], py = y + o[1];
+          orphan = orphan && (px < 0 || py < 0 || px >= imp_.width || py >= imp_.height || imp_(px, py) < 0);
+        }
+        if (orphan) offer(x, y);
+      }
+  }
+
+  // A traced pixel's values as the contrast sees them: RGB through a square root (close to sRGB), alpha,
+  // quantised to 1/255 (finer than any floor worth setting).
+  void record(std::uint32_t pixel) {
+    const Rgba& c = image_.pixels[pixel];
+    auto code = [](float v) { return std::uint8_t(std::lround(255.0f * std::min(1.0f, std::max(0.0f, v)))); };
+    percept_.pixels[pixel] = {code(std::sqrt(std::max(0.0f, c.r))), code(std::sqrt(std::max(0.0f, c.g))),
+                              code(std::sqrt(std::max(0.0f, c.b))), code(c.a)};
+  }
+
+  // After `pixel` was traced: the children it may have completed, at every finer level.
+  void offer_children(std::uint32_t pixel) {
+    const int w = imp_.width, qx = int(pixel % std::uint32_t(w)), qy = int(pixel / std::uint32_t(w));
+    for (int level = pattern_.level(qx, qy) + 1; level < pattern_.num_levels; ++level)
+      for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
+        const int x = qx - o[0], y = qy - o[1];
+        if (x >= 0 && y >= 0 && x < w && y < imp_.height && pattern_.level(x, y) == level) offer(x, y);
+      }
+  }
+
+  // The best `count` waiting candidates; stale entries (a pixel re-offered at a higher priority, or taken) skipped.
+  std::vector<std::uint32_t> pop(std::size_t count) {
+    std::vector<std::uint32_t> batch;
+    while (batch.size() < count && queue_.size() > 0)
+      for (std::uint32_t p : queue_.pop(count - batch.size()))
+        if (!taken_.pixels[p]) {
+          taken_.pixels[p] = 1;
+          batch.push_back(p);
+        }
+    return batch;
+  }
+
+  std::size_t waiting() const { return queue_.size(); }
+
+ private:
+  void offer(int x, int y) {
+    if (known(x, y) || taken_(x, y)) return;
+    const int level = pattern_.level(x, y), lattice = 2 * parent_offset(level, pattern_.base_spacing);
+    std::array<float, 4> lo{INFINITY, INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
+      const int px = x + o[0], py = y + o[1];
+      if (px < 0 || py < 0 || px >= imp_.width || py >= imp_.height) continue;
+      // Required: the corners of the square cell being split (for an edge midpoint, the edge's two ends).
+      // The squares' centres beside an edge midpoint only add contrast: requiring them would let a flat
+      // neighbour cell block the refinement of an edge cell.
+      const bool corner = px % lattice == 0 && py % lattice == 0;
+      if (!known(px, py)) {
+        if (corner) return;  // offered again when this corner is traced
+        continue;
+      }
+      const std::array<std::uint8_t, 4>& c = percept_(px, py);
+      const std::array<float, 4> v{float(c[0]), float(c[1]), float(c[2]), float(c[3])};
+      for (int k = 0; k < 4; ++k) {
+        lo[k] = std::min(lo[k], v[k]);
+        hi[k] = std::max(hi[k], v[k]);
+      }
+    }
+    float contrast = 0;
+    for (int k = 0; k < 4; ++k) contrast = std::max(contrast, (hi[k] - lo[k]) * (1.0f / 255.0f));
+    const auto pixel = std::uint32_t(y) * std::uint32_t(imp_.width) + std::uint32_t(x);
+    const float priority = (contrast + options_.floor + options_.line_weight * imp_(x, y)) * std::ldexp(1.0f, -level);
+    // Offered again when another parent was traced: only a clearly higher priority is worth a second entry.
+    if (priority <= 1.05f * offered_(x, y)) return;
+    queue_.push(priority, pixel);
+    offered_(x, y) = priority;
+  }
+
+  const ImageF& imp_;
+  const FractalPattern& pattern_;
+  const RefinementOptions& options_;
+  ImageRGBA& image_;
+  ImageMask& traced_;
+  ImageMask taken_;   ///< popped for tracing
+  ImageF offered_;    ///< highest priority offered so far (0 = never)
+  /// record()ed values of traced pixels in 1/255 steps (4 bytes a pixel); 0 on background, like its image.
+  Image<std::array<std::uint8_t, 4>> percept_;
+  BucketQueue queue_;
+};
+
+// A round in 16x16 tiles, tile rows top to bottom: the caster traces each group of kRayGroup rays together,
+// and a compact group shares volume blocks (scan order would stretch a group of sparse rays along a row).
+void in_tile_order(std::vector<std::uint32_t>& batch, int width) {
+  sort_by_key(batch.begin(), batch.end(), [width](std::uint32_t p) {
+    const std::uint32_t x = p % std::uint32_t(width), y = p / std::uint32_t(width);
+    return std::uint64_t((y / 16) * 4096u + x / 16) << 32 | p;
+  });
+}
+
+// A budgeted round in 16x16 tiles (neighbouring rays share volume blocks), the tiles in a hashed order, so the
+// prefix the deadline leaves is spread over the frame rather than its top rows.
+void in_hashed_tile_order(std::vector<std::uint32_t>& batch, int width, std::uint64_t seed) {
+  sort_by_key(batch.begin(), batch.end(), [width, seed](std::uint32_t p) {
+    const std::uint32_t x = p % std::uint32_t(width), y = p / std::uint32_t(width);
+    return std::uint64_t(pixel_hash((y / 16) * 4096u + x / 16, seed)) << 32 | p;
+  });
+}
+
+// Rays to launch in the next round: an eighth of what is left, so late rounds see the early rounds' samples.
+std::size_t round_size(const RefinementStop& stop, std::size_t done, double rays_per_ms) {
+  if (stop.now) {
+    const double ms = stop.deadline_ms - (*stop.now)();
+    if (ms <= 0) return 0;
+    // The estimate only sizes the round; trace_until stops at the deadline whatever it says.
+    return std::max(kMinRound, std::size_t(ms * rays_per_ms) / 8);
+  } else {
+  }
+  if (done >= stop.rays) return 0;
+  const std::size_t left = stop.rays - done;
+  return std::min(left, std::max(kMinRound, left / 8));
+}
+
+}  // namespace
+
+RefinementResult trace_refined(const ImageF& importance, const FractalPattern& pattern,
+                               const RefinementOptions& options, const RefinementStop& stop, std::uint64_t seed,
+                               const TraceBatch& trace, ImageRGBA& image, ImageMask& traced) {
+  const int w = importance.width, h = importance.height;
+  std::vector<std::uint32_t> level0;
+  for (int y = 0; y < h; y += pattern.base_spacing)
+    for (int x = 0; x < w; x += pattern.base_spacing)
+      if (importance(x, y) >= 0) level0.push_back(std::uint32_t(y) * std::uint32_t(w) + std::uint32_t(x));
+  in_tile_order(level0, w);
+  // Budget rounds are sized from the rate measured on the stop's own clock (the deadline decides anyway).
+  const Timer wall;
+  const ElapsedMs clock = stop.now ? *stop.now : ElapsedMs([&wall] { return wall.elapsed_ms(); });
+  const double level0_start = clock();
+  trace_all(level0, trace, image);
+  const double level0_ms = std::max(1e-3, clock() - level0_start);
+  RefinementResult result;
+  result.level0 = result.rays = level0.size();
+  for (std::uint32_t p : level0) traced.pixels[p] = 1;
+  result.level0_overran = stop.now && (*stop.now)() > stop.deadline_ms;
+  double rays_per_ms = double(level0.size()) / level0_ms;
+
+  Refiner refiner(importance, pattern, options, seed, image, traced);
+  for (std::uint32_t p : level0) refiner.record(p);
+  refiner.offer_orphans();
+  for (std::uint32_t p : level0) refiner.offer_children(p);
+  while (refiner.waiting() > 0) {
+    // At most a quarter of the waiting candidates per round, so every round is a choice among them and an
+    // edge can be followed down several levels (one per round) before the budget is spent on breadth.
+    const std::size_t want = std::min(round_size(stop, result.rays, rays_per_ms),
+                                      std::max<std::size_t>(1, refiner.waiting() / 4));
+    if (want == 0) break;
+    std::vector<std::uint32_t> batch = refiner.pop(want);
+    const std::size_t popped = batch.size();
+    if (popped == 0) break;  // only stale entries were left
+    if (stop.now) {
+      in_hashed_tile_order(batch, w, seed);
+      const double start = clock();
+      batch.resize(trace_until(batch, trace, image, *stop.now, stop.deadline_ms));
+      rays_per_ms = std::max(rays_per_ms * 0.25, double(batch.size()) / std::max(1e-3, clock() - start));
+    } else {
+      in_tile_order(batch, w);
+      trace_all(batch, trace, image);
+    }
+    for (std::uint32_t p : batch) {
+      traced.pixels[p] = 1;
+      refiner.record(p);
+    }
+    for (std::uint32_t p : batch) refiner.offer_children(p);
+    result.rays += batch.size();
+    if (batch.size() < popped) break;  // the deadline cut the round
+  }
+  return result;
+}
+
+}  // namespace raysift::sampling

@@ -1,0 +1,48 @@
+#pragma once
+/// \file A posteriori ray placement (issue 13 item 3): trace the level-0 lattice, then refine where the traced
+/// samples disagree. A pixel of pattern level l >= 1 becomes a candidate once its four parents (fractal_pattern.h)
+/// are known (traced, background, or outside the image); its priority is the expected interpolation error it
+/// removes, (contrast of its parents + floor + line_weight * p_imp) * 2^-l: the contrast is the largest
+/// per-channel spread of the parents (RGB through a square root, close to the sRGB the metrics see), 2^-l the
+/// share of the frame one ray of that level covers. The floor keeps coverage even where the samples agree
+/// (subsampling's strength on shaded texture). Candidates are traced in rounds of the highest priorities;
+/// each round's samples raise or lower their children's priorities. Every traced cell's corners are
+/// traced, so the hierarchical reconstruction (reconstruction.h) builds on them.
+#include <cstdint>
+
+#include "core/image.h"
+#include "sampling/fractal_pattern.h"
+#include "sampling/image_mask.h"
+#include "sampling/scheduler.h"
+
+namespace raysift::sampling {
+
+struct RefinementOptions {
+  bool enabled = true;      ///< false = the a priori queue of the RP paper (ray_order.h)
+  float floor = 0.02f;      ///< contrast every candidate gets for free (uniform coverage)
+  float line_weight = 0.1f; ///< weight of the line importance p_imp in [0,1]
+};
+
+/// Where to stop: a ray count, or (now != nullptr) once `*now` reaches deadline_ms.
+struct RefinementStop {
+  std::size_t rays = 0;
+  double deadline_ms = 0;
+  const ElapsedMs* now = nullptr;
+};
+
+struct RefinementResult {
+  std::size_t rays = 0;         ///< traced in all
+  std::size_t level0 = 0;       ///< of which level-0 object pixels (always traced)
+  bool level0_overran = false;  ///< the deadline had passed after level 0 alone
+};
+
+/// \brief Traces level 0 and then refines until the stop (or every object pixel is traced).
+/// \param importance < 0 = background (never traced), else p_imp
+/// \param image receives the traced values; \param traced is set to 1 on traced pixels
+/// With a ray-count stop the result is the same for any thread count (rounds and ties are fixed by the
+/// samples and `seed`); a deadline cuts wherever the clock says.
+RefinementResult trace_refined(const ImageF& importance, const FractalPattern& pattern, const RefinementOptions& options,
+                               const RefinementStop& stop, std::uint64_t seed, const TraceBatch& trace,
+                               ImageRGBA& image, ImageMask& traced);
+
+}  // namespace raysift::sampling

@@ -1,0 +1,154 @@
+// A posteriori refinement (sampling/refinement.h) with mock tracers of known output and cost.
+#include "sampling/refinement.h"
+
+#include <gtest/gtest.h>
+#include <tbb/task_arena.h>
+
+#include <atomic>
+#include <cmath>
+#include <vector>
+
+#include "sampling/prioritized.h"
+#include "sampling/reconstruction.h"
+
+namespace raysift::sampling {
+namespace {
+
+constexpr int kW = 96, kH = 72;
+
+// A disc on background (importance -1 outside, 0 inside).
+ImageF disc() {
+  ImageF imp(kW, kH, -1.0f);
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x)
+      if (std::hypot(x + 0.5 - 48.0, y + 0.5 - 36.0) < 30) imp(x, y) = 0.0f;
+  return imp;
+}
+
+using Colour = Rgba (*)(int x, int y);
+Rgba step_edge(int x, int) { return x < 50 ? Rgba{0.1f, 0.1f, 0.1f, 1} : Rgba{0.9f, 0.8f, 0.7f, 1}; }
+Rgba affine(int x, int y) { return {0.1f + 0.005f * x, 0.8f - 0.004f * y, 0.3f + 0.002f * (x + y), 0.6f}; }
+
+TraceBatch tracer(Colour colour, std::vector<int>* count = nullptr, std::atomic<std::int64_t>* clock_us = nullptr) {
+  return [=](Span<const std::uint32_t> pixels, Span<Rgba> out) {
+    for (std::size_t i = 0; i < pixels.size(); ++i) {
+      out[i] = colour(int(pixels[i] % kW), int(pixels[i] / kW));
+      if (count) ++(*count)[pixels[i]];  // tests trace serially where they count
+    }
+    if (clock_us) *clock_us += 10 * std::int64_t(pixels.size());  // 10 virtual us per ray
+  };
+}
+
+std::size_t object_pixels(const ImageF& imp) {
+  std::size_t n = 0;
+  for (float v : imp.pixels) n += v >= 0 ? 1 : 0;
+  return n;
+}
+
+TEST(Refinement, TracedCellsHaveTracedCornersAndTheRequestedCount) {
+  const ImageF imp = disc();
+  const FractalPattern p = make_fractal_pattern(kW, kH, 8);
+  for (std::size_t rays : {std::size_t(300), std::size_t(900), object_pixels(imp)}) {
+    ImageRGBA image(kW, kH);
+    ImageMask traced(kW, kH, 0);
+    RefinementStop stop;
+    stop.rays = rays;
+    const RefinementResult r = trace_refined(imp, p, {}, stop, 1, tracer(step_edge), image, traced);
+    std::size_t marked = 0;
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x) {
+        if (!traced(x, y)) continue;
+        ++marked;
+        ASSERT_GE(imp(x, y), 0) << "background traced at " << x << "," << y;
+        const int level = p.level(x, y);
+        if (level == 0) continue;
+        const int d = parent_offset(level, 8);
+        const bool square = level % 2 == 1;  // square centres: diagonal parents; diamond centres: axial
+        const int ox[4] = {-d, d, square ? -d : 0, square ? d : 0};
+        const int oy[4] = {square ? -d : 0, square ? -d : 0, square ? d : -d, d};
+        for (int k = 0; k < 4; ++k) {
+          const int px = x + ox[k], py = y + oy[k];
+          if (px < 0 || py < 0 || px >= kW || py >= kH || imp(px, py) < 0) continue;
+          if (px % (2 * d) != 0 || py % (2 * d) != 0) continue;  // a square's centre beside an edge midpoint
+          ASSERT_TRUE(traced(px, py)) << "pixel " << x << "," << y << " traced before its corner " << px << "," << py;
+        }
+      }
+    EXPECT_EQ(r.rays, marked);
+    EXPECT_EQ(r.rays, std::min(rays, object_pixels(imp)));
+  }
+}
+
+TEST(Refinement, RaysGoToTheEdgeAndEveryPixelIsTracedOnceAtFractionOne) {
+  // No background here: the disc's rim (alpha 1 against 0) would be an edge too.
+  const ImageF imp(kW, kH, 0.0f);
+  const FractalPattern p = make_fractal_pattern(kW, kH, 8);
+  std::vector<int> count(imp.size(), 0);
+  ImageRGBA image(kW, kH);
+  ImageMask traced(kW, kH, 0);
+  RefinementStop stop;
+  stop.rays = 1000;  // 14% of the pixels
+  tbb::task_arena serial(1);  // the counting tracer is not thread-safe
+  serial.execute([&] { trace_refined(imp, p, {}, stop, 1, tracer(step_edge, &count), image, traced); });
+  // Object pixels within 3 px of the edge at x = 50 versus those farther than 10 px, per pixel.
+  double near = 0, near_n = 0, far = 0, far_n = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      if (imp(x, y) < 0) continue;
+      ASSERT_LE(count[std::size_t(y * kW + x)], 1);
+      if (std::abs(x - 50) <= 3) near += traced(x, y), ++near_n;
+      if (std::abs(x - 50) > 10) far += traced(x, y), ++far_n;
+    }
+  EXPECT_GT(near / near_n, 3 * far / far_n) << "contrast must pull rays to the edge";
+
+  stop.rays = object_pixels(imp);
+  std::fill(count.begin(), count.end(), 0);
+  ImageRGBA all(kW, kH);
+  ImageMask all_traced(kW, kH, 0);
+  serial.execute([&] { trace_refined(imp, p, {}, stop, 1, tracer(step_edge, &count), all, all_traced); });
+  for (std::size_t i = 0; i < imp.size(); ++i) ASSERT_EQ(count[i], imp.pixels[i] >= 0 ? 1 : 0);
+}
+
+TEST(Refinement, RefinedFrameOfAnAffineImageIsExact) {
+  // The samples are affine, so refinement and either reconstruction must give the image back exactly.
+  ImageF imp(kW, kH, 0.0f);
+  for (Interpolation mode : {Interpolation::Linear, Interpolation::Cubic}) {
+    SamplingOptions o;
+    o.ray_fraction = 0.15;
+    o.interpolation = mode;
+    const SampledFrame f = render_sampled(imp, tracer(affine), o);
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x) {
+        const Rgba e = affine(x, y), g = f.image(x, y);
+        // 2e-6: a few float roundings of values below 1.
+        ASSERT_NEAR(g.r, e.r, 2e-6) << x << "," << y;
+        ASSERT_NEAR(g.g, e.g, 2e-6) << x << "," << y;
+        ASSERT_NEAR(g.b, e.b, 2e-6) << x << "," << y;
+        ASSERT_NEAR(g.a, e.a, 2e-6) << x << "," << y;
+      }
+  }
+}
+
+TEST(Refinement, BudgetStopsLaunchingAtTheDeadlineOnAVirtualClock) {
+  const ImageF imp = disc();
+  std::atomic<std::int64_t> clock_us{0};
+  SamplingOptions o;
+  o.budget_ms = 12;
+  o.reconstruct_reserve_ms = 2;
+  o.clock_ms = [&clock_us] { return double(clock_us.load()) / 1000.0; };
+  const SampledFrame f = render_sampled(imp, tracer(step_edge, nullptr, &clock_us), o);
+  // 10 ms for rays = 1000 rays at 10 us; each of the workers may finish one group of 32 past the deadline.
+  const double workers = tbb::this_task_arena::max_concurrency();
+  EXPECT_FALSE(f.budget_too_small);
+  EXPECT_GE(double(f.rays_traced), 1000.0);
+  EXPECT_LE(double(f.rays_traced), 1000.0 + workers * double(kRayGroup));
+  EXPECT_LT(f.rays_traced, object_pixels(imp));
+
+  clock_us = 0;
+  o.budget_ms = 1;  // level 0 (~40 rays, 0.4 ms) plus the 2 ms reserve overrun it
+  const SampledFrame tiny = render_sampled(imp, tracer(step_edge, nullptr, &clock_us), o);
+  EXPECT_TRUE(tiny.budget_too_small);
+  EXPECT_EQ(tiny.rays_traced, tiny.level0_rays);
+}
+
+}  // namespace
+}  // namespace raysift::sampling
