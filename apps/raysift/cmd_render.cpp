@@ -43,6 +43,8 @@ struct RenderCliOptions {
   int progressive = 0;
   std::string feature_mesh;
   std::string feature_cache;  ///< directory of the on-disk feature cache; empty = memory only
+  bool no_refine = false;
+  std::string interpolation = sampling::SamplingOptions{}.interpolation == sampling::Interpolation::Cubic ? "cubic" : "linear";
 };
 
 /// Everything a mode needs, built once from flags and scene.
@@ -149,6 +151,7 @@ void validate(const RenderCliOptions& o) {
   if (!(o.ray_fraction > 0 && o.ray_fraction <= 1)) bad_flag("--ray-fraction", "in (0, 1]", num(o.ray_fraction));
   if (!(o.budget_ms >= 0) || !std::isfinite(o.budget_ms)) bad_flag("--budget-ms", ">= 0 (0 = no budget)", num(o.budget_ms));
   if (o.progressive < 0) bad_flag("--progressive", ">= 0 frames", std::to_string(o.progressive));
+  if (o.interpolation != "cubic" && o.interpolation != "linear") bad_flag("--interpolation", "linear|cubic", o.interpolation);
   if ((o.budget_ms > 0 || o.progressive > 0) && o.mode != "prioritized")
     throw UsageError("--budget-ms and --progressive need --mode prioritized; see --help");
 }
@@ -201,6 +204,9 @@ RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common
   in.sampled.sampling.mode = sampling::parse_sampling_mode(o.mode);
   in.sampled.sampling.ray_fraction = o.ray_fraction;
   in.sampled.sampling.budget_ms = o.budget_ms;
+  in.sampled.sampling.refinement.enabled = !o.no_refine;
+  in.sampled.sampling.interpolation =
+      o.interpolation == "cubic" ? sampling::Interpolation::Cubic : sampling::Interpolation::Linear;
   in.sampled.sampling.seed = common.seed;
   in.sampled.progressive_frames = o.progressive;
   in.sampled.feature_mesh = o.feature_mesh;
@@ -329,6 +335,10 @@ RegisterCommand reg(
           ->capture_default_str();
       sub.add_option("--feature-mesh", opt->feature_mesh,
                      "prioritized: prepared feature mesh (e.g. from raysift mesh) instead of extracting iso-surfaces");
+      sub.add_flag("--no-refine", opt->no_refine,
+                   "prioritized: place rays by the a priori queue only (no contrast refinement from level 0)");
+      sub.add_option("--interpolation", opt->interpolation, "sampled modes: reconstruction rule, linear|cubic")
+          ->capture_default_str();
       sub.add_option("--feature-cache", opt->feature_cache,
                      "prioritized: directory caching the feature geometry across runs (keyed by volume, TF, options)");
       sub.footer(
