@@ -60,6 +60,11 @@ struct ImportanceBuffer {
 /// background. \pre 0 <= x < frame_width, 0 <= y < frame_height.
 float sample_importance(const ImportanceBuffer& buffer, int x, int y);
 
+/// sample_importance() at every frame pixel, in one pass over the frame: buffer rows without background
+/// take a separable bilinear in float (equal to sample_importance within 1e-6, float rounding), the
+/// others sample_importance itself. Identical for any thread count.
+ImageF upsample_importance(const ImportanceBuffer& buffer, bool threaded = true);
+
 /// Rasterises already visible lines (features/visibility.h) into an importance buffer for `frame`.
 /// \throw InvalidInput for options outside their ranges or an empty/NaN background mesh.
 ImportanceBuffer rasterize_importance(const FeatureLines& visible_lines, const Camera& frame,

@@ -15,10 +15,98 @@ namespace {
 
 constexpr int kBandRows = 16;
 
+struct ScreenPoint {
+  double x, y, inv_z;
+};
+
+/// A triangle ready to draw: edge functions e_j = ea·x + eb·y + ec (barycentric coordinates) and the
+/// affine 1/z plane, computed once however many bands it spans.
 struct ScreenTri {
-  float x[3], y[3], inv_z[3];  // float keeps the array small; set-up and coverage run in double
+  double ea[3], eb[3], ec[3];
+  double ia, ib, ic;
   int r0, r1, c0, c1;  // rows and columns whose pixel centres the triangle's bounds span (inclusive)
   std::uint32_t face;
+};
+
+/// Screen set-up; false if the triangle covers no pixel centre's bounds or is degenerate. Corners are
+/// rounded to float first (as stored before), so the image does not depend on how the work is split.
+bool set_up(const ScreenPoint* p0, const ScreenPoint* p1, const ScreenPoint* p2, std::uint32_t face, int width,
+            int height, ScreenTri& st) {
+  const ScreenPoint* corner[3] = {p0, p1, p2};
+  double x[3], y[3], iz[3];
+  for (int j = 0; j < 3; ++j) {
+    x[j] = double(float(corner[j]->x));
+    y[j] = double(float(corner[j]->y));
+    iz[j] = double(float(corner[j]->inv_z));
+  }
+  // Pixel centres (i + 0.5) inside the bounds; triangles that cover none are dropped here.
+  const double x0 = std::min({x[0], x[1], x[2]}), x1 = std::max({x[0], x[1], x[2]});
+  const double y0 = std::min({y[0], y[1], y[2]}), y1 = std::max({y[0], y[1], y[2]});
+  st.c0 = int(std::max(0.0, std::ceil(x0 - 0.5)));
+  st.c1 = int(std::min(double(width - 1), std::floor(x1 - 0.5)));
+  st.r0 = int(std::max(0.0, std::ceil(y0 - 0.5)));
+  st.r1 = int(std::min(double(height - 1), std::floor(y1 - 0.5)));
+  if (st.c0 > st.c1 || st.r0 > st.r1) return false;
+  const double area = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
+  if (!(std::abs(area) > 1e-12)) return false;
+  // Edge function of the edge opposite corner j, scaled by 1/area so that it is the barycentric
+  // coordinate.
+  for (int j = 0; j < 3; ++j) {
+    const int a = (j + 1) % 3, c = (j + 2) % 3;
+    st.ea[j] = -(y[c] - y[a]) / area;
+    st.eb[j] = (x[c] - x[a]) / area;
+    st.ec[j] = -(st.ea[j] * x[a] + st.eb[j] * y[a]);
+  }
+  // 1/z is affine on screen too: iz(x, y) = ia·x + ib·y + ic.
+  st.ia = st.ea[0] * iz[0] + st.ea[1] * iz[1] + st.ea[2] * iz[2];
+  st.ib = st.eb[0] * iz[0] + st.eb[1] * iz[1] + st.eb[2] * iz[2];
+  st.ic = st.ec[0] * iz[0] + st.ec[1] * iz[1] + st.ec[2] * iz[2];
+  st.face = face;
+  return true;
+}
+
+/// Depth-tests the triangle's pixels in rows [r0, r1].
+void draw(const ScreenTri& st, int r0, int r1, DepthBuffer& out) {
+  for (int r = r0; r <= r1; ++r) {
+    const double py = r + 0.5;
+    // The covered columns of this row form one span: each edge bounds px = col + 0.5 from one side.
+    int lo = st.c0, hi = st.c1;
+    for (int j = 0; j < 3 && lo <= hi; ++j) {
+      const double k = st.eb[j] * py + st.ec[j];  // b_j = ea[j]·px + k >= 0
+      if (st.ea[j] > 0)
+        lo = std::max(lo, int(std::ceil(-k / st.ea[j] - 0.5)));
+      else if (st.ea[j] < 0)
+        hi = std::min(hi, int(std::floor(-k / st.ea[j] - 0.5)));
+      else if (k < 0)
+        hi = lo - 1;
+    }
+    float* depth = &out.depth(0, r);
+    std::uint32_t* faces = &out.face(0, r);
+    for (int col = lo; col <= hi; ++col) {
+      const float z = float(1.0 / (st.ia * (col + 0.5) + st.ib * py + st.ic));
+      if (z < depth[col] || (z == depth[col] && st.face < faces[col])) {
+        depth[col] = z;
+        faces[col] = st.face;
+      }
+    }
+  }
+}
+
+/// The triangles of one chunk of faces, binned into bands of kBandRows rows (CSR, in face order).
+struct Chunk {
+  std::vector<ScreenTri> tris;
+  std::vector<std::uint32_t> band_offset, band_tris;
+  void bin(int bands) {
+    band_offset.assign(std::size_t(bands) + 1, 0);
+    for (const ScreenTri& st : tris)
+      for (int b = st.r0 / kBandRows; b <= st.r1 / kBandRows; ++b) ++band_offset[std::size_t(b) + 1];
+    for (int b = 0; b < bands; ++b) band_offset[std::size_t(b) + 1] += band_offset[std::size_t(b)];
+    band_tris.resize(band_offset.back());
+    std::vector<std::uint32_t> fill(band_offset.begin(), band_offset.end() - 1);
+    for (std::size_t i = 0; i < tris.size(); ++i)
+      for (int b = tris[i].r0 / kBandRows; b <= tris[i].r1 / kBandRows; ++b)
+        band_tris[fill[std::size_t(b)]++] = std::uint32_t(i);
+  }
 };
 
 struct ViewPoint {
@@ -71,9 +159,6 @@ DepthBuffer rasterize_depth(const mesh::TriMesh& mesh, const Camera& camera, con
 
   // Vertices in view space and, when in front of the near plane, on screen (once per vertex).
   std::vector<ViewPoint> view(mesh.vertex_count());
-  struct ScreenPoint {
-    double x, y, inv_z;
-  };
   std::vector<ScreenPoint> screen(mesh.vertex_count());
   auto to_screen = [&](const ViewPoint& p) {
     return ScreenPoint{(p.x / p.z / tan_x + 1.0) * 0.5 * width, (1.0 - p.y / p.z / tan_y) * 0.5 * height, 1.0 / p.z};
@@ -86,27 +171,17 @@ DepthBuffer rasterize_depth(const mesh::TriMesh& mesh, const Camera& camera, con
     }
   });
 
-  // Triangles crossing the near plane are clipped (Sutherland-Hodgman against one plane) and fanned.
+  // Per chunk of faces (in parallel): clip at the near plane, set up the edge and depth planes once, and
+  // bin the triangles into bands of rows. The depth test breaks ties by face index, so the order in
+  // which a band visits its triangles does not change the image.
   constexpr std::size_t kChunk = 8192;
-  std::vector<std::vector<ScreenTri>> parts((mesh.triangle_count() + kChunk - 1) / kChunk);
+  const int bands = (height + kBandRows - 1) / kBandRows;
+  std::vector<Chunk> chunks((mesh.triangle_count() + kChunk - 1) / kChunk);
   for_chunks(mesh.triangle_count(), kChunk, options.threaded, [&](std::size_t c, std::size_t b, std::size_t e) {
+    std::vector<ScreenTri>& tris = chunks[c].tris;
     auto add = [&](const ScreenPoint* p0, const ScreenPoint* p1, const ScreenPoint* p2, std::uint32_t face) {
       ScreenTri st;
-      st.face = face;
-      const ScreenPoint* corner[3] = {p0, p1, p2};
-      for (int j = 0; j < 3; ++j) {
-        st.x[j] = float(corner[j]->x);
-        st.y[j] = float(corner[j]->y);
-        st.inv_z[j] = float(corner[j]->inv_z);
-      }
-      // Pixel centres (i + 0.5) inside the bounds; triangles that cover none are dropped here.
-      const double x0 = std::min({st.x[0], st.x[1], st.x[2]}), x1 = std::max({st.x[0], st.x[1], st.x[2]});
-      const double y0 = std::min({st.y[0], st.y[1], st.y[2]}), y1 = std::max({st.y[0], st.y[1], st.y[2]});
-      st.c0 = int(std::max(0.0, std::ceil(x0 - 0.5)));
-      st.c1 = int(std::min(double(width - 1), std::floor(x1 - 0.5)));
-      st.r0 = int(std::max(0.0, std::ceil(y0 - 0.5)));
-      st.r1 = int(std::min(double(height - 1), std::floor(y1 - 0.5)));
-      if (st.c0 <= st.c1 && st.r0 <= st.r1) parts[c].push_back(st);
+      if (set_up(p0, p1, p2, face, width, height, st)) tris.push_back(st);
     };
     for (std::size_t f = b; f < e; ++f) {
       const auto& t = mesh.triangles[f];
@@ -130,68 +205,15 @@ DepthBuffer rasterize_depth(const mesh::TriMesh& mesh, const Camera& camera, con
       for (int k = 0; k < n; ++k) sp[k] = to_screen(poly[k]);
       for (int k = 1; k + 1 < n; ++k) add(&sp[0], &sp[k], &sp[k + 1], std::uint32_t(f));
     }
+    chunks[c].bin(bands);
   });
-  // Triangles in face order without copying the per-chunk arrays.
-  std::vector<const ScreenTri*> tris;
-  for (const auto& p : parts)
-    for (const ScreenTri& st : p) tris.push_back(&st);
-
-  // Bin the triangles into bands of rows, in triangle order.
-  const int bands = (height + kBandRows - 1) / kBandRows;
-  std::vector<std::uint32_t> band_offset(std::size_t(bands) + 1, 0);
-  for (const ScreenTri* st : tris)
-    for (int b = st->r0 / kBandRows; b <= st->r1 / kBandRows; ++b) ++band_offset[std::size_t(b) + 1];
-  for (int b = 0; b < bands; ++b) band_offset[std::size_t(b) + 1] += band_offset[std::size_t(b)];
-  std::vector<std::uint32_t> band_tris(band_offset.back());
-  std::vector<std::uint32_t> fill(band_offset.begin(), band_offset.end() - 1);
-  for (std::size_t i = 0; i < tris.size(); ++i)
-    for (int b = tris[i]->r0 / kBandRows; b <= tris[i]->r1 / kBandRows; ++b)
-      band_tris[fill[std::size_t(b)]++] = std::uint32_t(i);
 
   for_chunks(std::size_t(bands), 1, options.threaded, [&](std::size_t band, std::size_t, std::size_t) {
     const int band_r0 = int(band) * kBandRows, band_r1 = std::min(height - 1, band_r0 + kBandRows - 1);
-    for (std::uint32_t k = band_offset[band]; k < band_offset[band + 1]; ++k) {
-      const ScreenTri& st = *tris[band_tris[k]];
-      const double x[3] = {st.x[0], st.x[1], st.x[2]}, y[3] = {st.y[0], st.y[1], st.y[2]};
-      const double area = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
-      if (!(std::abs(area) > 1e-12)) continue;
-      // Edge function of the edge opposite corner j, scaled by 1/area so that it is the barycentric
-      // coordinate: e_j(x, y) = a_j·x + b_j·y + c_j.
-      double ea[3], eb[3], ec[3];
-      for (int j = 0; j < 3; ++j) {
-        const int a = (j + 1) % 3, c = (j + 2) % 3;
-        ea[j] = -(y[c] - y[a]) / area;
-        eb[j] = (x[c] - x[a]) / area;
-        ec[j] = -(ea[j] * x[a] + eb[j] * y[a]);
-      }
-      // 1/z is affine on screen too: iz(x, y) = ia·x + ib·y + ic.
-      const double ia = ea[0] * st.inv_z[0] + ea[1] * st.inv_z[1] + ea[2] * st.inv_z[2];
-      const double ib = eb[0] * st.inv_z[0] + eb[1] * st.inv_z[1] + eb[2] * st.inv_z[2];
-      const double ic = ec[0] * st.inv_z[0] + ec[1] * st.inv_z[1] + ec[2] * st.inv_z[2];
-      for (int r = std::max(st.r0, band_r0); r <= std::min(st.r1, band_r1); ++r) {
-        const double py = r + 0.5;
-        // The covered columns of this row form one span: each edge bounds px = col + 0.5 from one side.
-        int lo = st.c0, hi = st.c1;
-        for (int j = 0; j < 3 && lo <= hi; ++j) {
-          const double k = eb[j] * py + ec[j];  // b_j = ea[j]·px + k >= 0
-          if (ea[j] > 0)
-            lo = std::max(lo, int(std::ceil(-k / ea[j] - 0.5)));
-          else if (ea[j] < 0)
-            hi = std::min(hi, int(std::floor(-k / ea[j] - 0.5)));
-          else if (k < 0)
-            hi = lo - 1;
-        }
-        for (int col = lo; col <= hi; ++col) {
-          const float z = float(1.0 / (ia * (col + 0.5) + ib * py + ic));
-          float& cur = out.depth(col, r);
-          std::uint32_t& cur_face = out.face(col, r);
-          if (z < cur || (z == cur && st.face < cur_face)) {
-            cur = z;
-            cur_face = st.face;
-          }
-        }
-      }
-    }
+    for (const Chunk& chunk : chunks)
+      for (std::uint32_t k = chunk.band_offset[band]; k < chunk.band_offset[band + 1]; ++k)
+        draw(chunk.tris[chunk.band_tris[k]], std::max(chunk.tris[chunk.band_tris[k]].r0, band_r0),
+             std::min(chunk.tris[chunk.band_tris[k]].r1, band_r1), out);
   });
   return out;
 }
