@@ -23,6 +23,7 @@
 #include "core/json_io.h"
 #include "core/timer.h"
 #include "features/importance.h"
+#include "features/raster.h"
 #include "mesh/mesh_io.h"
 #include "sampling/volume_sampling.h"
 #include "volume/raycaster.h"
@@ -51,6 +52,18 @@ CameraSpec load_camera(const SceneCase& c, int width, int height) {
   return cam;
 }
 
+/// CPU time of the calling thread.
+struct ThreadCpuTimer {
+  double start = now();
+  static double now() {
+    timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return 1e3 * double(ts.tv_sec) + 1e-6 * double(ts.tv_nsec);
+  }
+  void reset() { start = now(); }
+  double elapsed_ms() const { return now() - start; }
+};
+
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0.0 : v[v.size() / 2];
@@ -72,7 +85,19 @@ sampling::FeatureGeometry feature_geometry(const SceneCase& c, const volume::Vol
 
 struct Samples {
   std::vector<double> full_phong, full_plain, importance, mask, lines, visibility, raster;
+  std::vector<double> cpu_full_phong, cpu_full_plain, cpu_importance;  ///< process CPU time, all threads
 };
+
+/// Wall ms of f(), and its process CPU ms (all threads) into `cpu`.
+template <typename F>
+double timed(std::vector<double>& cpu, const F& f) {
+  const std::clock_t c0 = std::clock();
+  Timer t;
+  f();
+  const double wall = t.elapsed_ms();
+  cpu.push_back(1000.0 * double(std::clock() - c0) / CLOCKS_PER_SEC);
+  return wall;
+}
 
 void run_view(const SceneCase& c, const volume::Volume& vol, const volume::TransferFunction& tf,
               const sampling::FeatureGeometry& geometry, const char* mesh_name, int width, int height,
@@ -87,16 +112,10 @@ void run_view(const SceneCase& c, const volume::Volume& vol, const volume::Trans
   Samples s;
   std::size_t background = 0;
   for (int r = 0; r < rounds; ++r) {
+    s.full_phong.push_back(timed(s.cpu_full_phong, [&] { volume::render_full(caster); }));
+    s.full_plain.push_back(timed(s.cpu_full_plain, [&] { volume::render_full(plain); }));
+    s.importance.push_back(timed(s.cpu_importance, [&] { sampling::frame_importance(caster, &geometry, features); }));
     Timer t;
-    volume::render_full(caster);
-    s.full_phong.push_back(t.elapsed_ms());
-    t.reset();
-    volume::render_full(plain);
-    s.full_plain.push_back(t.elapsed_ms());
-    t.reset();
-    const ImageF importance = sampling::frame_importance(caster, &geometry, features);
-    s.importance.push_back(t.elapsed_ms());
-    t.reset();
     const Image<std::uint8_t> mask = caster.background_mask();
     s.mask.push_back(t.elapsed_ms());
     background = std::size_t(std::count(mask.pixels.begin(), mask.pixels.end(), std::uint8_t(1)));
@@ -108,11 +127,13 @@ void run_view(const SceneCase& c, const volume::Volume& vol, const volume::Trans
     s.raster.push_back(stages.raster_ms);
   }
   const double imp = median(s.importance);
-  std::printf("%-19s %-7s %4dx%-4d %7zu tris | full phong %7.1f none %7.1f | importance %6.2f = mask %5.2f lines %5.2f "
-              "vis %5.2f raster %5.2f | %5.2f%% of phong, %5.2f%% of none | bg %4.1f%%\n",
+  const double cpu_imp = median(s.cpu_importance);
+  std::printf("%-18s %-7s %4dx%-4d %6zu tris | full phong %7.1f none %7.1f | importance %6.2f = mask %5.2f lines %5.2f "
+              "vis %5.2f raster %5.2f | wall %5.2f%% of phong %5.2f%% of none | CPU %5.2f%% %5.2f%% | bg %4.1f%%\n",
               c.name.c_str(), mesh_name, width, height, geometry.mesh.triangles.size(), median(s.full_phong),
               median(s.full_plain), imp, median(s.mask), median(s.lines), median(s.visibility), median(s.raster),
               100.0 * imp / median(s.full_phong), 100.0 * imp / median(s.full_plain),
+              100.0 * cpu_imp / median(s.cpu_full_phong), 100.0 * cpu_imp / median(s.cpu_full_plain),
               100.0 * double(background) / double(width * height));
   std::fflush(stdout);
 }
@@ -137,7 +158,8 @@ int main(int argc, char** argv) {
     sampling::FeatureOptions features;
     features.classes = sampling::parse_feature_list(feature_list);
     features.importance.scale = scale;
-    std::printf("importance_bench: features %s, importance scale %g, %d threads, medians of %d rounds (ms)\n",
+    std::printf("importance_bench: features %s, importance scale %g, %d threads, medians of %d rounds (wall ms; "
+                "ratios also in process CPU time, which the machine's load changes less)\n",
                 feature_list.c_str(), scale, tbb::this_task_arena::max_concurrency(), rounds);
     const std::string dir = std::string(RAYSIFT_SOURCE_DIR) + "/datasets/";
     const std::vector<SceneCase> cases = {
@@ -164,6 +186,40 @@ int main(int argc, char** argv) {
         }
         std::printf("%s: importance median %.2f ms wall, %.2f ms CPU (all threads) over %d runs\n", c.name.c_str(),
                     median(ms), median(cpu), profile);
+        // Serial stage costs in thread CPU time, which the machine's load hardly changes.
+        features::LineOptions lo = features.lines;
+        lo.classes = features.classes;
+        lo.threaded = false;
+        std::vector<double> t_mask, t_lines, t_depth, t_vis, t_raster, t_up;
+        const Camera small(features::scaled_camera(caster.camera().spec(), scale));
+        for (int i = 0; i < profile; ++i) {
+          ThreadCpuTimer t;
+          caster.background_mask(false);
+          t_mask.push_back(t.elapsed_ms());
+          t.reset();
+          const features::FeatureLines lines = features::extract_lines(fine.mesh, fine.curvature, small.eye(), lo);
+          t_lines.push_back(t.elapsed_ms());
+          t.reset();
+          const features::DepthBuffer depth = features::rasterize_depth(fine.mesh, small, {false});
+          t_depth.push_back(t.elapsed_ms());
+          t.reset();
+          features::VisibilityOptions vo;
+          vo.classes = lo.classes;
+          vo.threaded = false;
+          const features::FeatureLines visible = features::remove_hidden_lines(lines, depth, vo);
+          t_vis.push_back(t.elapsed_ms());
+          t.reset();
+          features::ImportanceOptions io = features.importance;
+          io.threaded = false;
+          const features::ImportanceBuffer b = features::rasterize_importance(visible, caster.camera(), {}, io);
+          t_raster.push_back(t.elapsed_ms());
+          t.reset();
+          features::upsample_importance(b, false);
+          t_up.push_back(t.elapsed_ms());
+        }
+        std::printf("serial CPU ms: mask %.2f lines %.2f depth raster %.2f visibility %.2f importance raster %.2f "
+                    "upsample %.2f\n", median(t_mask), median(t_lines), median(t_depth), median(t_vis),
+                    median(t_raster), median(t_up));
         return 0;
       }
       for (const auto& res : {std::pair<int, int>{1440, 900}, std::pair<int, int>{960, 600}}) {

@@ -15,6 +15,18 @@ namespace {
 
 constexpr int kBandRows = 16;
 
+/// floor and ceil for |x| < 2^31 without a libm call (std::floor is one without SSE4.1); callers clamp
+/// to the image first or pass screen coordinates of visible geometry.
+int floor_int(double x) {
+  const int i = int(x);
+  return i - (x < double(i) ? 1 : 0);
+}
+int ceil_int(double x) {
+  const int i = int(x);
+  return i + (x > double(i) ? 1 : 0);
+}
+double clamp_px(double x) { return std::clamp(x, -1e9, 1e9); }  // keeps the int conversions defined
+
 struct ScreenPoint {
   double x, y, inv_z;
 };
@@ -42,10 +54,10 @@ bool set_up(const ScreenPoint* p0, const ScreenPoint* p1, const ScreenPoint* p2,
   // Pixel centres (i + 0.5) inside the bounds; triangles that cover none are dropped here.
   const double x0 = std::min({x[0], x[1], x[2]}), x1 = std::max({x[0], x[1], x[2]});
   const double y0 = std::min({y[0], y[1], y[2]}), y1 = std::max({y[0], y[1], y[2]});
-  st.c0 = int(std::max(0.0, std::ceil(x0 - 0.5)));
-  st.c1 = int(std::min(double(width - 1), std::floor(x1 - 0.5)));
-  st.r0 = int(std::max(0.0, std::ceil(y0 - 0.5)));
-  st.r1 = int(std::min(double(height - 1), std::floor(y1 - 0.5)));
+  st.c0 = std::max(0, ceil_int(clamp_px(x0 - 0.5)));
+  st.c1 = std::min(width - 1, floor_int(clamp_px(x1 - 0.5)));
+  st.r0 = std::max(0, ceil_int(clamp_px(y0 - 0.5)));
+  st.r1 = std::min(height - 1, floor_int(clamp_px(y1 - 0.5)));
   if (st.c0 > st.c1 || st.r0 > st.r1) return false;
   const double area = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
   if (!(std::abs(area) > 1e-12)) return false;
@@ -65,8 +77,38 @@ bool set_up(const ScreenPoint* p0, const ScreenPoint* p1, const ScreenPoint* p2,
   return true;
 }
 
+/// One band of rows being drawn: the nearest surface as 1/z (double, 0 = empty), so a fragment costs no
+/// division; converted to depth once per pixel at the end.
+struct Band {
+  int r0, width;
+  std::vector<double> inv_z;
+  std::vector<std::uint32_t> face;
+  void test(const ScreenTri& st, int col, int row, double px, double py) {
+    const double iz = st.ia * px + st.ib * py + st.ic;
+    const std::size_t i = std::size_t(row - r0) * std::size_t(width) + std::size_t(col);
+    if (iz > inv_z[i] || (iz == inv_z[i] && st.face < face[i])) {
+      inv_z[i] = iz;
+      face[i] = st.face;
+    }
+  }
+};
+
 /// Depth-tests the triangle's pixels in rows [r0, r1].
-void draw(const ScreenTri& st, int r0, int r1, DepthBuffer& out) {
+void draw(const ScreenTri& st, int r0, int r1, Band& band) {
+  // At importance resolution most triangles span a few pixels: testing each centre against the edges
+  // needs no division, unlike the per-row span below.
+  if ((st.c1 - st.c0 + 1) * (r1 - r0 + 1) <= 8) {
+    for (int r = r0; r <= r1; ++r) {
+      const double py = r + 0.5;
+      for (int col = st.c0; col <= st.c1; ++col) {
+        const double px = col + 0.5;
+        if (st.ea[0] * px + st.eb[0] * py + st.ec[0] >= 0 && st.ea[1] * px + st.eb[1] * py + st.ec[1] >= 0 &&
+            st.ea[2] * px + st.eb[2] * py + st.ec[2] >= 0)
+          band.test(st, col, r, px, py);
+      }
+    }
+    return;
+  }
   for (int r = r0; r <= r1; ++r) {
     const double py = r + 0.5;
     // The covered columns of this row form one span: each edge bounds px = col + 0.5 from one side.
@@ -74,39 +116,20 @@ void draw(const ScreenTri& st, int r0, int r1, DepthBuffer& out) {
     for (int j = 0; j < 3 && lo <= hi; ++j) {
       const double k = st.eb[j] * py + st.ec[j];  // b_j = ea[j]·px + k >= 0
       if (st.ea[j] > 0)
-        lo = std::max(lo, int(std::ceil(-k / st.ea[j] - 0.5)));
+        lo = std::max(lo, ceil_int(clamp_px(-k / st.ea[j] - 0.5)));
       else if (st.ea[j] < 0)
-        hi = std::min(hi, int(std::floor(-k / st.ea[j] - 0.5)));
+        hi = std::min(hi, floor_int(clamp_px(-k / st.ea[j] - 0.5)));
       else if (k < 0)
         hi = lo - 1;
     }
-    float* depth = &out.depth(0, r);
-    std::uint32_t* faces = &out.face(0, r);
-    for (int col = lo; col <= hi; ++col) {
-      const float z = float(1.0 / (st.ia * (col + 0.5) + st.ib * py + st.ic));
-      if (z < depth[col] || (z == depth[col] && st.face < faces[col])) {
-        depth[col] = z;
-        faces[col] = st.face;
-      }
-    }
+    for (int col = lo; col <= hi; ++col) band.test(st, col, r, col + 0.5, py);
   }
 }
 
-/// The triangles of one chunk of faces, binned into bands of kBandRows rows (CSR, in face order).
+/// The triangles of one chunk of faces, copied into each band of kBandRows rows they touch (in face
+/// order), so that drawing a band streams through contiguous memory.
 struct Chunk {
-  std::vector<ScreenTri> tris;
-  std::vector<std::uint32_t> band_offset, band_tris;
-  void bin(int bands) {
-    band_offset.assign(std::size_t(bands) + 1, 0);
-    for (const ScreenTri& st : tris)
-      for (int b = st.r0 / kBandRows; b <= st.r1 / kBandRows; ++b) ++band_offset[std::size_t(b) + 1];
-    for (int b = 0; b < bands; ++b) band_offset[std::size_t(b) + 1] += band_offset[std::size_t(b)];
-    band_tris.resize(band_offset.back());
-    std::vector<std::uint32_t> fill(band_offset.begin(), band_offset.end() - 1);
-    for (std::size_t i = 0; i < tris.size(); ++i)
-      for (int b = tris[i].r0 / kBandRows; b <= tris[i].r1 / kBandRows; ++b)
-        band_tris[fill[std::size_t(b)]++] = std::uint32_t(i);
-  }
+  std::vector<std::vector<ScreenTri>> bands;
 };
 
 struct ViewPoint {
@@ -125,6 +148,7 @@ void for_chunks(std::size_t n, std::size_t chunk, bool threaded, const F& body) 
     for (std::size_t c = 0; c < chunks; ++c) run(c);
   }
 }
+
 
 }  // namespace
 
@@ -178,10 +202,12 @@ DepthBuffer rasterize_depth(const mesh::TriMesh& mesh, const Camera& camera, con
   const int bands = (height + kBandRows - 1) / kBandRows;
   std::vector<Chunk> chunks((mesh.triangle_count() + kChunk - 1) / kChunk);
   for_chunks(mesh.triangle_count(), kChunk, options.threaded, [&](std::size_t c, std::size_t b, std::size_t e) {
-    std::vector<ScreenTri>& tris = chunks[c].tris;
+    std::vector<std::vector<ScreenTri>>& by_band = chunks[c].bands;
+    by_band.resize(std::size_t(bands));
     auto add = [&](const ScreenPoint* p0, const ScreenPoint* p1, const ScreenPoint* p2, std::uint32_t face) {
       ScreenTri st;
-      if (set_up(p0, p1, p2, face, width, height, st)) tris.push_back(st);
+      if (!set_up(p0, p1, p2, face, width, height, st)) return;
+      for (int band = st.r0 / kBandRows; band <= st.r1 / kBandRows; ++band) by_band[std::size_t(band)].push_back(st);
     };
     for (std::size_t f = b; f < e; ++f) {
       const auto& t = mesh.triangles[f];
@@ -205,15 +231,20 @@ DepthBuffer rasterize_depth(const mesh::TriMesh& mesh, const Camera& camera, con
       for (int k = 0; k < n; ++k) sp[k] = to_screen(poly[k]);
       for (int k = 1; k + 1 < n; ++k) add(&sp[0], &sp[k], &sp[k + 1], std::uint32_t(f));
     }
-    chunks[c].bin(bands);
   });
 
-  for_chunks(std::size_t(bands), 1, options.threaded, [&](std::size_t band, std::size_t, std::size_t) {
-    const int band_r0 = int(band) * kBandRows, band_r1 = std::min(height - 1, band_r0 + kBandRows - 1);
+  for_chunks(std::size_t(bands), 1, options.threaded, [&](std::size_t b, std::size_t, std::size_t) {
+    const int band_r0 = int(b) * kBandRows, band_r1 = std::min(height - 1, band_r0 + kBandRows - 1);
+    const std::size_t n = std::size_t(band_r1 - band_r0 + 1) * std::size_t(width);
+    Band band{band_r0, width, std::vector<double>(n, 0.0), std::vector<std::uint32_t>(n, kNoFace)};
     for (const Chunk& chunk : chunks)
-      for (std::uint32_t k = chunk.band_offset[band]; k < chunk.band_offset[band + 1]; ++k)
-        draw(chunk.tris[chunk.band_tris[k]], std::max(chunk.tris[chunk.band_tris[k]].r0, band_r0),
-             std::min(chunk.tris[chunk.band_tris[k]].r1, band_r1), out);
+      for (const ScreenTri& st : chunk.bands[b]) draw(st, std::max(st.r0, band_r0), std::min(st.r1, band_r1), band);
+    // Rounding is monotone, so float(1 / max 1/z) is the least float depth of the fragments.
+    for (std::size_t i = 0; i < n; ++i) {
+      if (band.face[i] == kNoFace) continue;
+      out.depth.pixels[std::size_t(band_r0) * std::size_t(width) + i] = float(1.0 / band.inv_z[i]);
+      out.face.pixels[std::size_t(band_r0) * std::size_t(width) + i] = band.face[i];
+    }
   });
   return out;
 }

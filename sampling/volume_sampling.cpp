@@ -95,8 +95,12 @@ ImageF frame_importance(const volume::RayCaster& caster, const FeatureGeometry* 
         geometry->mesh, geometry->curvature, caster.camera(), lines, features::BackgroundGeometry{}, options.importance);
     importance = features::upsample_importance(buffer, options.importance.threaded);
   }
-  for (std::size_t i = 0; i < importance.size(); ++i)
-    importance.pixels[i] = background.pixels[i] ? -1.0f : std::min(1.0f, std::max(0.0f, importance.pixels[i]));
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, importance.size(), 1 << 14),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i)
+                        importance.pixels[i] =
+                            background.pixels[i] ? -1.0f : std::min(1.0f, std::max(0.0f, importance.pixels[i]));
+                    });
   return importance;
 }
 

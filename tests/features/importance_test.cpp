@@ -205,6 +205,26 @@ TEST(Importance, SampleUpsamplesBilinearlyAndNeverBlendsBackground) {
   EXPECT_FLOAT_EQ(sample_importance(b, 5, 2), 0.0f);
 }
 
+// The one-pass upsampling is sample_importance at every frame pixel: within float rounding (values in
+// [0, 1], a few float ulps) on rows without background, exactly on rows that touch background; the same
+// for 1 and 2 threads. Odd sizes make the buffer-to-frame ratio non-integral.
+TEST(Importance, UpsampleMatchesSampleImportanceEverywhere) {
+  ImportanceBuffer b;
+  b.frame_width = 101;
+  b.frame_height = 67;
+  b.values = ImageF(23, 17, 0.0f);
+  for (int y = 0; y < 17; ++y)
+    for (int x = 0; x < 23; ++x) b.values(x, y) = float((x * 7 + y * 13) % 11) / 10.0f;
+  b.values(5, 9) = -1.0f;  // background in rows 9 (and its neighbours' interpolation)
+  const ImageF up = upsample_importance(b, true);
+  ASSERT_EQ(up.width, 101);
+  ASSERT_EQ(up.height, 67);
+  EXPECT_EQ(upsample_importance(b, false).pixels, up.pixels);
+  for (int y = 0; y < 67; ++y)
+    for (int x = 0; x < 101; ++x) ASSERT_NEAR(up(x, y), sample_importance(b, x, y), 1e-6) << x << "," << y;
+  EXPECT_FLOAT_EQ(up(5 * 101 / 23 + 2, 9 * 67 / 17 + 1), -1.0f);
+}
+
 TEST(Importance, RejectsBadOptions) {
   const Camera cam(front_camera(5.0));
   ImportanceOptions o;
