@@ -218,12 +218,27 @@ struct RayCaster::Impl {
   bool misses_visible_blocks(int x, int y) const {
     if (is_empty || !has_visible) return true;
     const Vec3d inv_d = pixel_inv_dir(x, y);
+    const Vec3d slack{kBlockSlackVoxels, kBlockSlackVoxels, kBlockSlackVoxels};
+    double t0, t1;
+    if (!clip_to_box(eye_is, inv_d, visible_lo - slack, visible_hi + slack, t0, t1) || t1 < 0.0) return true;
     for (std::uint32_t b : surface_blocks)
       if (ray_hits_block(inv_d, b)) return false;
     return true;
   }
 
   bool eye_near_visible_block() const;
+  /// Is the eye inside the (clipped, grown) box of a visible block? Then every ray hits it at t = 0.
+  bool eye_in_visible_block() const {
+    const Vec3d e = eye_is / double(kBlockSize);
+    const std::int64_t b =
+        bricks->block_index(int(std::floor(e.x)), int(std::floor(e.y)), int(std::floor(e.z)));
+    if (b < 0 || !block_visible[std::size_t(b)]) return false;
+    Vec3d lo, hi;
+    block_box(std::uint32_t(b), lo, hi);
+    const Vec3d slack{kBlockSlackVoxels, kBlockSlackVoxels, kBlockSlackVoxels};
+    return eye_is.x >= lo.x - slack.x && eye_is.y >= lo.y - slack.y && eye_is.z >= lo.z - slack.z &&
+           eye_is.x <= hi.x + slack.x && eye_is.y <= hi.y + slack.y && eye_is.z <= hi.z + slack.z;
+  }
   void find_surface_blocks();
 };
 
@@ -446,6 +461,10 @@ Image<std::uint8_t> RayCaster::background_mask(bool threaded) const {
     return std::move(hit);
   };
   if (m.is_empty || !m.has_visible) return to_background();
+  if (m.eye_in_visible_block()) {  // every ray starts inside a visible block: no background
+    std::fill(hit.pixels.begin(), hit.pixels.end(), std::uint8_t(1));
+    return to_background();
+  }
   if (m.eye_near_visible_block()) {  // near-plane clipping could lose faces beside the eye: test each ray
     parallel_rows(h, [&](int y) {
       for (int x = 0; x < w; ++x) hit(x, y) = m.misses_visible_blocks(x, y) ? 0 : 1;

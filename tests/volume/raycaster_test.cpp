@@ -386,6 +386,16 @@ TEST(RayCaster, BackgroundBetweenSeparatedBlocks) {
   EXPECT_FALSE(caster.pixel_is_background(0, 4));  // the left slab covers the image's left edge
   EXPECT_EQ(mask(0, 4), 0);
   EXPECT_FALSE(caster.trace(0, 4).color == Rgba{});
+  // An eye inside the left slab: every ray starts in a visible block, none is background.
+  cam.eye = {3.0, 7.5, 7.5};
+  cam.target = {3.0, 7.5, 0.0};
+  const RayCaster inside(vol, step_tf(0.4f, 0.5f), cam, opts(0.5));
+  const Image<std::uint8_t> all_object = inside.background_mask();
+  for (int y = 0; y < cam.height; ++y)
+    for (int x = 0; x < cam.width; ++x) {
+      ASSERT_EQ(all_object(x, y), 0) << x << "," << y;
+      ASSERT_FALSE(inside.pixel_is_background(x, y));
+    }
 }
 
 TEST(RayCaster, NonFiniteVoxelsAndOddCamerasGiveFiniteImages) {
