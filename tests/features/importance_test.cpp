@@ -106,7 +106,9 @@ TEST_F(SphereImportance, BackgroundIsNegativeObjectZeroSilhouetteOne) {
   BackgroundGeometry bg;
   bg.mesh = &mesh_;
   FeatureLines visible;
-  const ImportanceBuffer b = compute_importance(mesh_, curvature_, cam, {}, bg, {}, &visible);
+  ImportanceOptions half;  // the analytic radii below are for a 128 px buffer (the default is 0.25)
+  half.scale = 0.5;
+  const ImportanceBuffer b = compute_importance(mesh_, curvature_, cam, {}, bg, half, &visible);
   EXPECT_GT(visible.count(LineClass::Silhouette), 0u);
   EXPECT_EQ(b.values.width, 128);
   EXPECT_EQ(b.values(0, 0), -1.0f);      // corner: the ray misses the sphere
