@@ -141,7 +141,10 @@ TEST_F(SphereImportance, BackgroundIsNegativeObjectZeroSilhouetteOne) {
 TEST_F(SphereImportance, BoundingBoxBackgroundAndCameraInsideIt) {
   BackgroundGeometry bg;
   bg.bbox_ws = Bbox3d{{-1, -1, -1}, {1, 1, 1}};
-  const ImportanceBuffer outside = compute_importance(mesh_, curvature_, Camera(front_camera(6.0)), {}, bg);
+  ImportanceOptions half;  // pixel (64, 64) is the centre of a 128 px buffer
+  half.scale = 0.5;
+  const ImportanceBuffer outside = compute_importance(mesh_, curvature_, Camera(front_camera(6.0)), {}, bg, half);
+  ASSERT_EQ(outside.values.width, 128);
   EXPECT_LT(outside.values(0, 0), 0.0f);
   EXPECT_GE(outside.values(64, 64), 0.0f);
   // A camera inside the box: every ray hits it, so nothing is background; lines of the sphere behind
