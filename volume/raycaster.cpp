@@ -191,6 +191,9 @@ struct RayCaster::Impl {
 
   RaySample trace(int x, int y) const;
 
+  /// Block coordinate of an eye coordinate (in blocks), clamped so a far eye stays in the int range.
+  static int eye_block(double b) { return int(std::floor(std::clamp(b, -1e9, 1e9))); }
+
   /// Unit index-space direction reciprocal of the ray through pixel (x, y)'s centre, as trace() builds it.
   Vec3d pixel_inv_dir(int x, int y) const {
     const Vec3d d = normalize(to_index_dir(camera.ray(x + 0.5, y + 0.5).direction));
@@ -231,7 +234,7 @@ struct RayCaster::Impl {
   bool eye_in_visible_block() const {
     const Vec3d e = eye_is / double(kBlockSize);
     const std::int64_t b =
-        bricks->block_index(int(std::floor(e.x)), int(std::floor(e.y)), int(std::floor(e.z)));
+        bricks->block_index(eye_block(e.x), eye_block(e.y), eye_block(e.z));
     if (b < 0 || !block_visible[std::size_t(b)]) return false;
     Vec3d lo, hi;
     block_box(std::uint32_t(b), lo, hi);
@@ -339,7 +342,7 @@ void RayCaster::Impl::find_surface_blocks() {
 
 bool RayCaster::Impl::eye_near_visible_block() const {
   const Vec3d e = eye_is / double(kBlockSize);
-  const Vec3i eb{int(std::floor(e.x)), int(std::floor(e.y)), int(std::floor(e.z))};
+  const Vec3i eb{eye_block(e.x), eye_block(e.y), eye_block(e.z)};
   for (int dz = -1; dz <= 1; ++dz)
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
@@ -394,10 +397,10 @@ bool project_face(const Vec3d (&p_is)[4], const double (&to_view)[3][3], const V
     y0 = std::min(y0, f.y[i]), y1 = std::max(y1, f.y[i]);
   }
   const double m = kFootprintMarginPx;
-  f.c0 = int(std::max(0.0, std::ceil(x0 - m - 0.5)));
-  f.c1 = int(std::min(double(cam.width() - 1), std::floor(x1 + m - 0.5)));
-  f.r0 = int(std::max(0.0, std::ceil(y0 - m - 0.5)));
-  f.r1 = int(std::min(double(cam.height() - 1), std::floor(y1 + m - 0.5)));
+  f.c0 = int(std::clamp(std::ceil(x0 - m - 0.5), 0.0, double(cam.width())));
+  f.c1 = int(std::clamp(std::floor(x1 + m - 0.5), -1.0, double(cam.width() - 1)));
+  f.r0 = int(std::clamp(std::ceil(y0 - m - 0.5), 0.0, double(cam.height())));
+  f.r1 = int(std::clamp(std::floor(y1 + m - 0.5), -1.0, double(cam.height() - 1)));
   return f.c0 <= f.c1 && f.r0 <= f.r1;
 }
 
@@ -430,12 +433,14 @@ void fill_footprint(const Footprint& f, int r0, int r1, Image<std::uint8_t>& hit
     int in_lo = f.c0, in_hi = is_flat ? f.c0 - 1 : f.c1, out_lo = f.c0, out_hi = f.c1;
     for (int e = 0; e < edges; ++e) {
       const double k_in = m - eb[e] * py - ec[e], k_out = -m - eb[e] * py - ec[e];  // need a·px > k
+      // Clamped before the int conversion: a near-horizontal edge puts the bound far off-screen.
+      auto col = [](double c) { return std::clamp(c, -2.0, 1e9); };
       if (ea[e] > 0) {
-        in_lo = std::max(in_lo, int(std::floor(k_in / ea[e] - 0.5)) + 1);
-        out_lo = std::max(out_lo, int(std::ceil(k_out / ea[e] - 0.5)));
+        in_lo = std::max(in_lo, int(col(std::floor(k_in / ea[e] - 0.5))) + 1);
+        out_lo = std::max(out_lo, int(col(std::ceil(k_out / ea[e] - 0.5))));
       } else if (ea[e] < 0) {
-        in_hi = std::min(in_hi, int(std::ceil(k_in / ea[e] - 0.5)) - 1);
-        out_hi = std::min(out_hi, int(std::floor(k_out / ea[e] - 0.5)));
+        in_hi = std::min(in_hi, int(col(std::ceil(k_in / ea[e] - 0.5))) - 1);
+        out_hi = std::min(out_hi, int(col(std::floor(k_out / ea[e] - 0.5))));
       } else {
         if (k_in >= 0) in_hi = in_lo - 1;
         if (k_out > 0) out_hi = out_lo - 1;
