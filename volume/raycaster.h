@@ -105,14 +105,15 @@ class RayCaster {
   void trace_pixels(Span<const std::uint32_t> pixel_indices, Span<RaySample> out) const;
   /// True iff the pixel's ray misses every TF-visible 8³ block, each block taken as a closed index-space
   /// box clipped to the volume's domain and grown by 1e-6 voxels (covering the rounding of the sample
-  /// positions). Then trace() returns transparent black with zero samples, whatever the skipping
-  /// setting. The exact reference of background_mask(): up to one ray-box test per visible block on the
+  /// positions). Then trace() returns transparent black (with zero samples when skipping is on).
+  /// The exact reference of background_mask(): up to one ray-box test per visible block on the
   /// volume's outer surface, so use the mask for whole frames.
   bool pixel_is_background(int x, int y) const;
   /// pixel_is_background() for every pixel (1 = background), equal to it pixel for pixel, from the screen
   /// footprints of the visible blocks' outer faces: a pixel whose centre lies clearly inside a footprint
-  /// hits; only centres within 0.01 px of a footprint edge get the exact ray-box test. Falls back to the
-  /// per-pixel test when the eye is within one block of a visible block. Identical for any thread count.
+  /// hits; only centres within 0.01 px of a footprint edge get the exact ray-box test. An eye inside a
+  /// visible block sees no background; an eye within one block of one falls back to the per-pixel test.
+  /// Identical for any thread count.
   Image<std::uint8_t> background_mask(bool threaded = true) const;
 
   /// Number of 8³ blocks with a non-zero opacity somewhere in their value range (diagnostics).
