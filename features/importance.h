@@ -32,7 +32,9 @@
 namespace raysift::features {
 
 struct ImportanceOptions {
-  double scale = 0.5;  ///< buffer size / frame size per axis, in (0, 1]; sides are rounded, at least 1 px
+  /// Buffer size / frame size per axis, in (0, 1]; sides are rounded, at least 1 px. 0.25 (360 px wide at
+  /// 1440x900) was better than 0.5 at equal rays in bench/prioritized_bench and cheaper (docs/feature_lines.md).
+  double scale = 0.25;
   /// Priority per LineClass (index = int(LineClass)), each in [0, 1].
   std::array<float, kLineClassCount> priority{1.0f, 1.0f, 0.6f, 0.6f, 0.6f, 0.6f};
   double falloff_px = 8.0;          ///< fall-off radius in FRAME pixels (> 0); smoothstep from line to 0
@@ -59,6 +61,11 @@ struct ImportanceBuffer {
 /// non-negative neighbours; the background value if the buffer pixel containing the frame pixel centre is
 /// background. \pre 0 <= x < frame_width, 0 <= y < frame_height.
 float sample_importance(const ImportanceBuffer& buffer, int x, int y);
+
+/// sample_importance() at every frame pixel, in one pass over the frame: buffer rows without background
+/// take a separable bilinear in float (equal to sample_importance within 1e-6, float rounding), the
+/// others sample_importance itself. Identical for any thread count.
+ImageF upsample_importance(const ImportanceBuffer& buffer, bool threaded = true);
 
 /// Rasterises already visible lines (features/visibility.h) into an importance buffer for `frame`.
 /// \throw InvalidInput for options outside their ranges or an empty/NaN background mesh.

@@ -26,8 +26,9 @@ struct RasterOptions {
 };
 
 /// Renders `mesh` (both sides, no culling) into a depth buffer at the camera's resolution. Ties in depth
-/// go to the lower triangle index, so the result is identical for any thread count. Degenerate
-/// triangles cover no pixel; the near plane sits at 1e-6 × the mesh bbox diagonal in front of the eye.
+/// (compared as 1/depth in double) go to the lower triangle index, so the result is identical for any thread
+/// count. Degenerate triangles cover no pixel; the near plane sits at 1e-6 × the mesh bbox diagonal in front
+/// of the eye.
 /// \throw InvalidInput if a used vertex is NaN/Inf or an index is out of range.
 DepthBuffer rasterize_depth(const mesh::TriMesh& mesh, const Camera& camera, const RasterOptions& options = {});
 

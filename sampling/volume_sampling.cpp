@@ -18,27 +18,23 @@ features::LineClassSet parse_feature_list(const std::string& list) {
 
 ImageF frame_importance(const volume::RayCaster& caster, const FeatureGeometry* geometry,
                         const FeatureOptions& options) {
-  const int w = caster.width(), h = caster.height();
-  ImageF importance(w, h, 0.0f);
-  features::ImportanceBuffer buffer;
-  const bool has_lines = geometry != nullptr && !options.classes.is_empty();
-  if (has_lines) {
+  // The caster's exact background (equal to pixel_is_background at every pixel), then the lines.
+  const Image<std::uint8_t> background = caster.background_mask();
+  ImageF importance(caster.width(), caster.height(), 0.0f);
+  if (geometry != nullptr && !options.classes.is_empty()) {
     features::LineOptions lines = options.lines;
     lines.classes = options.classes;
-    // No background geometry: the caster's exact test below decides background.
-    buffer = features::compute_importance(geometry->mesh, geometry->curvature, caster.camera(), lines,
-                                          features::BackgroundGeometry{}, options.importance);
+    // No background geometry: the mask above decides background.
+    const features::ImportanceBuffer buffer = features::compute_importance(
+        geometry->mesh, geometry->curvature, caster.camera(), lines, features::BackgroundGeometry{}, options.importance);
+    importance = features::upsample_importance(buffer, options.importance.threaded);
   }
-  tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
-    for (int y = rows.begin(); y < rows.end(); ++y)
-      for (int x = 0; x < w; ++x) {
-        if (caster.pixel_is_background(x, y)) {
-          importance(x, y) = -1.0f;
-        } else if (has_lines) {
-          importance(x, y) = std::min(1.0f, std::max(0.0f, features::sample_importance(buffer, x, y)));
-        }
-      }
-  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, importance.size(), 1 << 14),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i)
+                        importance.pixels[i] =
+                            background.pixels[i] ? -1.0f : std::min(1.0f, std::max(0.0f, importance.pixels[i]));
+                    });
   return importance;
 }
 

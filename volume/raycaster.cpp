@@ -12,9 +12,11 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/parallel.h"
 #include "volume/detail/brick_cache.h"
 #include "volume/detail/vdb_grid.h"
 
@@ -23,6 +25,9 @@ namespace raysift::volume {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+/// Growth of each block box in the background test, voxels: far above the rounding of sample positions
+/// (~1e-13 voxels), far below anything visible.
+constexpr double kBlockSlackVoxels = 1e-6;
 
 /// splitmix64 finaliser: a well-mixed 64-bit hash for per-pixel jitter.
 std::uint64_t hash64(std::uint64_t v) {
@@ -95,6 +100,12 @@ struct RayCaster::Impl {
   bool has_visible = false;
   Vec3d visible_lo, visible_hi;  ///< bbox of visible blocks' cells, index space
   std::uint64_t visible_blocks = 0;
+  /// Visible blocks with a non-visible (or missing) 6-neighbour: bit 2a+s of `outer_faces` set when the
+  /// face on side s (0 = low, 1 = high) of axis a borders no visible block. Every ray that hits a visible
+  /// block from outside enters the visible set through one of these faces.
+  std::vector<std::uint32_t> surface_blocks;
+  std::vector<std::uint8_t> outer_faces;
+  double index_to_world[3][3] = {};  ///< inverse of world_to_index
 
   Impl(std::shared_ptr<const VolumeBricks> b, const CameraSpec& spec, const RenderOptions& opt)
       : bricks(std::move(b)), camera(spec), options(opt) {}
@@ -179,6 +190,59 @@ struct RayCaster::Impl {
   }
 
   RaySample trace(int x, int y) const;
+
+  /// Block coordinate of an eye coordinate (in blocks), clamped so a far eye stays in the int range.
+  static int eye_block(double b) { return int(std::floor(std::clamp(b, -1e9, 1e9))); }
+
+  /// Unit index-space direction reciprocal of the ray through pixel (x, y)'s centre, as trace() builds it.
+  Vec3d pixel_inv_dir(int x, int y) const {
+    const Vec3d d = normalize(to_index_dir(camera.ray(x + 0.5, y + 0.5).direction));
+    return {1.0 / d.x, 1.0 / d.y, 1.0 / d.z};
+  }
+
+  /// Index-space box of block number `block` clipped to the domain (samples never leave the domain).
+  void block_box(std::uint32_t block, Vec3d& lo, Vec3d& hi) const {
+    const Vec3i& dims = bricks->dims;
+    const Vec3i b{int(block % std::uint32_t(dims.x)), int(block / std::uint32_t(dims.x) % std::uint32_t(dims.y)),
+                  int(block / (std::uint32_t(dims.x) * std::uint32_t(dims.y)))};
+    lo = max(Vec3d(b + bricks->block_min) * double(kBlockSize), domain_lo);
+    hi = min(Vec3d(b + bricks->block_min + Vec3i{1, 1, 1}) * double(kBlockSize), domain_hi);
+  }
+
+  /// The exact test behind pixel_is_background: does the ray hit the (slightly grown) box of the block?
+  bool ray_hits_block(const Vec3d& inv_d, std::uint32_t block) const {
+    Vec3d lo, hi;
+    block_box(block, lo, hi);
+    const Vec3d slack{kBlockSlackVoxels, kBlockSlackVoxels, kBlockSlackVoxels};
+    double t0, t1;
+    return clip_to_box(eye_is, inv_d, lo - slack, hi + slack, t0, t1) && t1 >= 0.0;
+  }
+
+  bool misses_visible_blocks(int x, int y) const {
+    if (is_empty || !has_visible) return true;
+    const Vec3d inv_d = pixel_inv_dir(x, y);
+    const Vec3d slack{kBlockSlackVoxels, kBlockSlackVoxels, kBlockSlackVoxels};
+    double t0, t1;
+    if (!clip_to_box(eye_is, inv_d, visible_lo - slack, visible_hi + slack, t0, t1) || t1 < 0.0) return true;
+    for (std::uint32_t b : surface_blocks)
+      if (ray_hits_block(inv_d, b)) return false;
+    return true;
+  }
+
+  bool eye_near_visible_block() const;
+  /// Is the eye inside the (clipped, grown) box of a visible block? Then every ray hits it at t = 0.
+  bool eye_in_visible_block() const {
+    const Vec3d e = eye_is / double(kBlockSize);
+    const std::int64_t b =
+        bricks->block_index(eye_block(e.x), eye_block(e.y), eye_block(e.z));
+    if (b < 0 || !block_visible[std::size_t(b)]) return false;
+    Vec3d lo, hi;
+    block_box(std::uint32_t(b), lo, hi);
+    const Vec3d slack{kBlockSlackVoxels, kBlockSlackVoxels, kBlockSlackVoxels};
+    return eye_is.x >= lo.x - slack.x && eye_is.y >= lo.y - slack.y && eye_is.z >= lo.z - slack.z &&
+           eye_is.x <= hi.x + slack.x && eye_is.y <= hi.y + slack.y && eye_is.z <= hi.z + slack.z;
+  }
+  void find_surface_blocks();
 };
 
 RaySample RayCaster::Impl::trace(int x, int y) const {
@@ -252,6 +316,230 @@ RaySample RayCaster::Impl::trace(int x, int y) const {
   return out;
 }
 
+void RayCaster::Impl::find_surface_blocks() {
+  const Vec3i& dims = bricks->dims;
+  auto visible = [&](int i, int j, int k) {
+    if (i < 0 || j < 0 || k < 0 || i >= dims.x || j >= dims.y || k >= dims.z) return false;
+    return block_visible[(std::size_t(k) * dims.y + j) * dims.x + i] != 0;
+  };
+  for (int k = 0; k < dims.z; ++k)
+    for (int j = 0; j < dims.y; ++j)
+      for (int i = 0; i < dims.x; ++i) {
+        if (!visible(i, j, k)) continue;
+        const int c[3] = {i, j, k};
+        std::uint8_t faces = 0;
+        for (int a = 0; a < 3; ++a)
+          for (int side = 0; side < 2; ++side) {
+            int n[3] = {c[0], c[1], c[2]};
+            n[a] += side ? 1 : -1;
+            if (!visible(n[0], n[1], n[2])) faces = std::uint8_t(faces | (1u << (2 * a + side)));
+          }
+        if (faces == 0) continue;
+        surface_blocks.push_back(std::uint32_t((std::size_t(k) * dims.y + j) * dims.x + i));
+        outer_faces.push_back(faces);
+      }
+}
+
+bool RayCaster::Impl::eye_near_visible_block() const {
+  const Vec3d e = eye_is / double(kBlockSize);
+  const Vec3i eb{eye_block(e.x), eye_block(e.y), eye_block(e.z)};
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const std::int64_t b = bricks->block_index(eb.x + dx, eb.y + dy, eb.z + dz);
+        if (b >= 0 && block_visible[std::size_t(b)]) return true;
+      }
+  return false;
+}
+
+namespace {
+
+/// Footprint margin in pixels: the projection and the ray set-up agree to ~1e-9 px, so a pixel centre
+/// farther than this inside a footprint surely hits and one farther outside surely misses.
+constexpr double kFootprintMarginPx = 0.01;
+constexpr int kMaskBandRows = 16;
+
+/// The screen footprint of one outer block face: a convex polygon (a quad, clipped at the near plane).
+struct Footprint {
+  std::uint32_t block;
+  int n = 0;
+  double x[8], y[8];
+  int r0, r1, c0, c1;  ///< rows/columns whose pixel centres lie within the margin of its bounds
+};
+
+/// View-space footprint of one face: corners `p_is` (cyclic order) -> camera axes -> clipped -> screen.
+bool project_face(const Vec3d (&p_is)[4], const double (&to_view)[3][3], const Vec3d& eye_is, double near,
+                  const Camera& cam, Footprint& f) {
+  Vec3d v[4];
+  int in_front = 0;
+  for (int i = 0; i < 4; ++i) {
+    const Vec3d d = p_is[i] - eye_is;
+    for (int r = 0; r < 3; ++r) v[i][r] = to_view[r][0] * d.x + to_view[r][1] * d.y + to_view[r][2] * d.z;
+    in_front += v[i].z >= near;
+  }
+  if (in_front == 0) return false;
+  Vec3d poly[8];
+  int n = 0;
+  for (int i = 0; i < 4; ++i) {  // Sutherland-Hodgman against z = near
+    const Vec3d& p = v[i];
+    const Vec3d& q = v[(i + 1) % 4];
+    if (p.z >= near) poly[n++] = p;
+    if ((p.z >= near) != (q.z >= near)) poly[n++] = p + (q - p) * ((near - p.z) / (q.z - p.z));
+  }
+  const double tan_y = std::tan(cam.spec().fov_y_deg * M_PI / 360.0);
+  const double tan_x = tan_y * double(cam.width()) / double(cam.height());
+  double x0 = kInf, x1 = -kInf, y0 = kInf, y1 = -kInf;
+  f.n = n;
+  for (int i = 0; i < n; ++i) {
+    f.x[i] = (poly[i].x / poly[i].z / tan_x + 1.0) * 0.5 * cam.width();
+    f.y[i] = (1.0 - poly[i].y / poly[i].z / tan_y) * 0.5 * cam.height();
+    x0 = std::min(x0, f.x[i]), x1 = std::max(x1, f.x[i]);
+    y0 = std::min(y0, f.y[i]), y1 = std::max(y1, f.y[i]);
+  }
+  const double m = kFootprintMarginPx;
+  f.c0 = int(std::clamp(std::ceil(x0 - m - 0.5), 0.0, double(cam.width())));
+  f.c1 = int(std::clamp(std::floor(x1 + m - 0.5), -1.0, double(cam.width() - 1)));
+  f.r0 = int(std::clamp(std::ceil(y0 - m - 0.5), 0.0, double(cam.height())));
+  f.r1 = int(std::clamp(std::floor(y1 + m - 0.5), -1.0, double(cam.height() - 1)));
+  return f.c0 <= f.c1 && f.r0 <= f.r1;
+}
+
+/// Marks the pixels of rows [r0, r1] that the footprint covers: centres clearly inside are hits, centres
+/// within the margin of its boundary get `exact_hit(x, y)`.
+template <typename ExactHit>
+void fill_footprint(const Footprint& f, int r0, int r1, Image<std::uint8_t>& hit, const ExactHit& exact_hit) {
+  double area = 0;
+  for (int i = 0; i < f.n; ++i) {
+    const int j = (i + 1) % f.n;
+    area += f.x[i] * f.y[j] - f.x[j] * f.y[i];
+  }
+  // Edge lines with unit normals pointing inside: e(x, y) = a·x + b·y + c is the signed distance.
+  double ea[8], eb[8], ec[8];
+  int edges = 0;
+  const bool is_flat = !(std::abs(area) > 1e-9);  // edge-on: every covered pixel gets the exact test
+  for (int i = 0; i < f.n && !is_flat; ++i) {
+    const int j = (i + 1) % f.n;
+    const double dx = f.x[j] - f.x[i], dy = f.y[j] - f.y[i], len = std::hypot(dx, dy);
+    if (!(len > 1e-12)) continue;
+    const double s = area > 0 ? 1.0 : -1.0;
+    ea[edges] = -s * dy / len;
+    eb[edges] = s * dx / len;
+    ec[edges] = -(ea[edges] * f.x[i] + eb[edges] * f.y[i]);
+    ++edges;
+  }
+  const double m = kFootprintMarginPx;
+  for (int r = std::max(r0, f.r0); r <= std::min(r1, f.r1); ++r) {
+    const double py = r + 0.5;
+    int in_lo = f.c0, in_hi = is_flat ? f.c0 - 1 : f.c1, out_lo = f.c0, out_hi = f.c1;
+    for (int e = 0; e < edges; ++e) {
+      const double k_in = m - eb[e] * py - ec[e], k_out = -m - eb[e] * py - ec[e];  // need a·px > k
+      // Clamped before the int conversion: a near-horizontal edge puts the bound far off-screen.
+      auto col = [](double c) { return std::clamp(c, -2.0, 1e9); };
+      if (ea[e] > 0) {
+        in_lo = std::max(in_lo, int(col(std::floor(k_in / ea[e] - 0.5))) + 1);
+        out_lo = std::max(out_lo, int(col(std::ceil(k_out / ea[e] - 0.5))));
+      } else if (ea[e] < 0) {
+        in_hi = std::min(in_hi, int(col(std::ceil(k_in / ea[e] - 0.5))) - 1);
+        out_hi = std::min(out_hi, int(col(std::floor(k_out / ea[e] - 0.5))));
+      } else {
+        if (k_in >= 0) in_hi = in_lo - 1;
+        if (k_out > 0) out_hi = out_lo - 1;
+      }
+    }
+    std::uint8_t* row = &hit(0, r);
+    if (in_lo <= in_hi) std::memset(row + in_lo, 1, std::size_t(in_hi - in_lo + 1));
+    for (int x = out_lo; x <= out_hi; ++x) {
+      if (x == in_lo && in_lo <= in_hi) x = in_hi + 1;
+      if (x <= out_hi && !row[x] && exact_hit(x, r)) row[x] = 1;
+    }
+  }
+}
+
+}  // namespace
+
+Image<std::uint8_t> RayCaster::background_mask(bool threaded) const {
+  const Impl& m = *impl_;
+  const int w = width(), h = height();
+  Image<std::uint8_t> hit(w, h, 0);
+  auto to_background = [&] {
+    for (std::uint8_t& p : hit.pixels) p = std::uint8_t(p ^ 1u);
+    return std::move(hit);
+  };
+  if (m.is_empty || !m.has_visible) return to_background();
+  if (m.eye_in_visible_block()) {  // every ray starts inside a visible block: no background
+    std::fill(hit.pixels.begin(), hit.pixels.end(), std::uint8_t(1));
+    return to_background();
+  }
+  if (m.eye_near_visible_block()) {  // near-plane clipping could lose faces beside the eye: test each ray
+    parallel_rows(h, [&](int y) {
+      for (int x = 0; x < w; ++x) hit(x, y) = m.misses_visible_blocks(x, y) ? 0 : 1;
+    }, threaded);
+    return to_background();
+  }
+  // Camera axes in index space: view = rows(right, up, forward) · index_to_world.
+  double to_view[3][3];
+  const Vec3d axes[3] = {m.camera.right(), m.camera.image_up(), m.camera.forward()};
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      to_view[r][c] = axes[r].x * m.index_to_world[0][c] + axes[r].y * m.index_to_world[1][c] +
+                      axes[r].z * m.index_to_world[2][c];
+  // The eye is more than a block from every face, so clipping this close loses no in-view ray.
+  double voxel_ws = kInf;
+  for (int c = 0; c < 3; ++c)
+    voxel_ws = std::min(voxel_ws, length(Vec3d{m.index_to_world[0][c], m.index_to_world[1][c], m.index_to_world[2][c]}));
+  const double near = 1e-3 * voxel_ws;
+
+  constexpr std::size_t kChunk = 512;
+  const std::size_t blocks = m.surface_blocks.size(), chunks = (blocks + kChunk - 1) / kChunk;
+  std::vector<std::vector<Footprint>> parts(chunks);
+  auto project_chunk = [&](std::size_t c) {
+    for (std::size_t i = c * kChunk; i < std::min(blocks, (c + 1) * kChunk); ++i) {
+      Vec3d lo, hi;
+      m.block_box(m.surface_blocks[i], lo, hi);
+      for (int a = 0; a < 3; ++a)
+        for (int side = 0; side < 2; ++side) {
+          const double plane = side ? hi[a] : lo[a];
+          // Only faces seen from outside can be where a ray enters (edge-on ones too, for the slack).
+          if (!((m.outer_faces[i] >> (2 * a + side)) & 1u) ||
+              (side ? m.eye_is[a] < plane - kBlockSlackVoxels : m.eye_is[a] > plane + kBlockSlackVoxels))
+            continue;
+          const int b = (a + 1) % 3, c2 = (a + 2) % 3;
+          Vec3d p[4];
+          for (int q = 0; q < 4; ++q) {
+            p[q][a] = plane;
+            p[q][b] = (q == 1 || q == 2) ? hi[b] : lo[b];
+            p[q][c2] = (q >= 2) ? hi[c2] : lo[c2];
+          }
+          Footprint f;
+          f.block = m.surface_blocks[i];
+          if (project_face(p, to_view, m.eye_is, near, m.camera, f)) parts[c].push_back(f);
+        }
+    }
+  };
+  // Bins: footprints per band of rows, in block order (the result is an OR, so order only fixes the work).
+  const int bands = (h + kMaskBandRows - 1) / kMaskBandRows;
+  std::vector<std::vector<const Footprint*>> bins(static_cast<std::size_t>(bands));
+  auto run = [&](std::size_t n, const auto& body) {
+    if (threaded) {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
+      });
+    } else {
+      for (std::size_t i = 0; i < n; ++i) body(i);
+    }
+  };
+  run(chunks, project_chunk);
+  for (const auto& part : parts)
+    for (const Footprint& f : part)
+      for (int b = f.r0 / kMaskBandRows; b <= f.r1 / kMaskBandRows; ++b) bins[std::size_t(b)].push_back(&f);
+  run(std::size_t(bands), [&](std::size_t band) {
+    const int r0 = int(band) * kMaskBandRows, r1 = std::min(h - 1, r0 + kMaskBandRows - 1);
+    for (const Footprint* f : bins[band])
+      fill_footprint(*f, r0, r1, hit, [&](int x, int y) { return m.ray_hits_block(m.pixel_inv_dir(x, y), f->block); });
+  });
+  return to_background();
+}
+
 std::shared_ptr<const VolumeBricks> build_volume_bricks(const Volume& volume) {
   return std::make_shared<const VolumeBricks>(build_volume_bricks_from_grid(*volume.impl().grid));
 }
@@ -277,6 +565,8 @@ RayCaster::RayCaster(const Volume& volume, std::shared_ptr<const VolumeBricks> b
     unit[a] = 1;
     const openvdb::Vec3d col = xform.worldToIndex(eye_ws + unit) - eye;
     for (int r = 0; r < 3; ++r) m.world_to_index[r][a] = col[r];
+    const openvdb::Vec3d back = xform.indexToWorld(eye + unit) - eye_ws;
+    for (int r = 0; r < 3; ++r) m.index_to_world[r][a] = back[r];
   }
 
   // Step-corrected, premultiplied table (ALGORITHMS.md §8: recompute from α_s, never rescale c̃).
@@ -319,6 +609,7 @@ RayCaster::RayCaster(const Volume& volume, std::shared_ptr<const VolumeBricks> b
     const Vec3d hi_cells = Vec3d(vis_hi + vb.block_min + Vec3i{1, 1, 1}) * double(kBlockSize);
     m.visible_lo = max(lo_cells, m.domain_lo);
     m.visible_hi = min(hi_cells, m.domain_hi);
+    m.find_surface_blocks();
   }
 }
 
@@ -345,13 +636,8 @@ void RayCaster::trace_pixels(Span<const std::uint32_t> pixel_indices, Span<RaySa
 }
 
 bool RayCaster::pixel_is_background(int x, int y) const {
-  const Impl& m = *impl_;
-  if (m.is_empty || !m.has_visible) return true;
-  const Ray ray = m.camera.ray(x + 0.5, y + 0.5);
-  const Vec3d d = normalize(m.to_index_dir(ray.direction));
-  const Vec3d inv_d{1.0 / d.x, 1.0 / d.y, 1.0 / d.z};
-  double t0, t1;
-  return !clip_to_box(m.eye_is, inv_d, m.visible_lo, m.visible_hi, t0, t1) || t1 < 0.0;
+  RAYSIFT_DCHECK(x >= 0 && x < width() && y >= 0 && y < height());
+  return impl_->misses_visible_blocks(x, y);
 }
 
 CameraSpec fit_camera(const Volume& volume, int width, int height) {

@@ -5,7 +5,8 @@
 ///   RayCaster caster(volume, tf, camera_spec, options);   // validates, builds LUT + skip blocks
 ///   RaySample s = caster.trace(x, y);                      // one pixel centre; thread-safe, no allocation
 ///   caster.trace_pixels(indices, out);                     // pixel index = y * width + x, any order/subset
-///   caster.pixel_is_background(x, y);                      // ray misses every TF-visible block's bbox
+///   caster.pixel_is_background(x, y);                      // ray misses every TF-visible block
+///   Image<uint8_t> bg = caster.background_mask();          // the same test for every pixel, fast
 ///   Rgba final = composite_over_background(s.color, caster.options().background);
 ///   RenderResult r = render_full(caster);                  // all pixels, TBB tiles, deterministic
 /// A RaySample is premultiplied and NOT yet composited over the background; every render mode must
@@ -102,10 +103,18 @@ class RayCaster {
   RaySample trace(int x, int y) const;
   /// out[i] = trace(pixel_indices[i] % width, pixel_indices[i] / width). \pre same sizes, valid indices.
   void trace_pixels(Span<const std::uint32_t> pixel_indices, Span<RaySample> out) const;
-  /// True if the pixel's ray misses the bounding box of all TF-visible blocks, i.e. trace() returns
-  /// transparent black (with zero samples when skipping is on). Cheap: one ray-box test. False does
-  /// not promise a hit: the ray may pass between visible blocks.
+  /// True iff the pixel's ray misses every TF-visible 8³ block, each block taken as a closed index-space
+  /// box clipped to the volume's domain and grown by 1e-6 voxels (covering the rounding of the sample
+  /// positions). Then trace() returns transparent black (with zero samples when skipping is on).
+  /// The exact reference of background_mask(): up to one ray-box test per visible block on the
+  /// volume's outer surface, so use the mask for whole frames.
   bool pixel_is_background(int x, int y) const;
+  /// pixel_is_background() for every pixel (1 = background), equal to it pixel for pixel, from the screen
+  /// footprints of the visible blocks' outer faces: a pixel whose centre lies clearly inside a footprint
+  /// hits; only centres within 0.01 px of a footprint edge get the exact ray-box test. An eye inside a
+  /// visible block sees no background; an eye within one block of one falls back to the per-pixel test.
+  /// Identical for any thread count.
+  Image<std::uint8_t> background_mask(bool threaded = true) const;
 
   /// Number of 8³ blocks with a non-zero opacity somewhere in their value range (diagnostics).
   std::uint64_t visible_block_count() const;

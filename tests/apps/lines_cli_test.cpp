@@ -75,7 +75,7 @@ TEST(LinesCli, WritesPictureSvgImportanceAndStats) {
   for (const char* key : {"curvature", "lines", "visibility", "raster"})
     EXPECT_TRUE(stats["times_ms"].contains(key)) << key;
   const ImageF importance = read_image_float(dir + "/ok.exr");
-  EXPECT_EQ(importance.width, 80);  // default --importance-scale 0.5
+  EXPECT_EQ(importance.width, 40);  // default --importance-scale 0.25
   EXPECT_EQ(importance(0, 0), -1.0f);
 
   EXPECT_EQ(r[1].code, 2) << r[1].err;

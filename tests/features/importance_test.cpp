@@ -106,7 +106,9 @@ TEST_F(SphereImportance, BackgroundIsNegativeObjectZeroSilhouetteOne) {
   BackgroundGeometry bg;
   bg.mesh = &mesh_;
   FeatureLines visible;
-  const ImportanceBuffer b = compute_importance(mesh_, curvature_, cam, {}, bg, {}, &visible);
+  ImportanceOptions half;  // the analytic radii below are for a 128 px buffer (the default is 0.25)
+  half.scale = 0.5;
+  const ImportanceBuffer b = compute_importance(mesh_, curvature_, cam, {}, bg, half, &visible);
   EXPECT_GT(visible.count(LineClass::Silhouette), 0u);
   EXPECT_EQ(b.values.width, 128);
   EXPECT_EQ(b.values(0, 0), -1.0f);      // corner: the ray misses the sphere
@@ -139,7 +141,10 @@ TEST_F(SphereImportance, BackgroundIsNegativeObjectZeroSilhouetteOne) {
 TEST_F(SphereImportance, BoundingBoxBackgroundAndCameraInsideIt) {
   BackgroundGeometry bg;
   bg.bbox_ws = Bbox3d{{-1, -1, -1}, {1, 1, 1}};
-  const ImportanceBuffer outside = compute_importance(mesh_, curvature_, Camera(front_camera(6.0)), {}, bg);
+  ImportanceOptions half;  // pixel (64, 64) is the centre of a 128 px buffer
+  half.scale = 0.5;
+  const ImportanceBuffer outside = compute_importance(mesh_, curvature_, Camera(front_camera(6.0)), {}, bg, half);
+  ASSERT_EQ(outside.values.width, 128);
   EXPECT_LT(outside.values(0, 0), 0.0f);
   EXPECT_GE(outside.values(64, 64), 0.0f);
   // A camera inside the box: every ray hits it, so nothing is background; lines of the sphere behind
@@ -203,6 +208,26 @@ TEST(Importance, SampleUpsamplesBilinearlyAndNeverBlendsBackground) {
   // Next to it, the background neighbour is left out of the interpolation (no value below 0).
   EXPECT_FLOAT_EQ(sample_importance(b, 5, 3), 0.0f);
   EXPECT_FLOAT_EQ(sample_importance(b, 5, 2), 0.0f);
+}
+
+// The one-pass upsampling is sample_importance at every frame pixel: within float rounding (values in
+// [0, 1], a few float ulps) on rows without background, exactly on rows that touch background; the same
+// for 1 and 2 threads. Odd sizes make the buffer-to-frame ratio non-integral.
+TEST(Importance, UpsampleMatchesSampleImportanceEverywhere) {
+  ImportanceBuffer b;
+  b.frame_width = 101;
+  b.frame_height = 67;
+  b.values = ImageF(23, 17, 0.0f);
+  for (int y = 0; y < 17; ++y)
+    for (int x = 0; x < 23; ++x) b.values(x, y) = float((x * 7 + y * 13) % 11) / 10.0f;
+  b.values(5, 9) = -1.0f;  // background in rows 9 (and its neighbours' interpolation)
+  const ImageF up = upsample_importance(b, true);
+  ASSERT_EQ(up.width, 101);
+  ASSERT_EQ(up.height, 67);
+  EXPECT_EQ(upsample_importance(b, false).pixels, up.pixels);
+  for (int y = 0; y < 67; ++y)
+    for (int x = 0; x < 101; ++x) ASSERT_NEAR(up(x, y), sample_importance(b, x, y), 1e-6) << x << "," << y;
+  EXPECT_FLOAT_EQ(up(5 * 101 / 23 + 2, 9 * 67 / 17 + 1), -1.0f);
 }
 
 TEST(Importance, RejectsBadOptions) {

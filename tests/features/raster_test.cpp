@@ -53,6 +53,20 @@ TEST(Raster, NearerTriangleWinsWhateverTheOrder) {
   EXPECT_EQ(a.depth.pixels, b.depth.pixels);
 }
 
+// Triangles are set up and binned per chunk of faces and drawn per band of rows, in parallel: the buffer
+// must not depend on the split (a mesh of many chunks, spanning many bands).
+TEST(Raster, SerialAndThreadedBuffersAreIdentical) {
+  const mesh::TriMesh sphere = mesh::make_icosphere(1.0, 6);  // 81920 faces: ten chunks
+  const Camera cam(camera({0.3, 0.4, 3.0}, {0, 0, 0}, 97, 131));
+  const DepthBuffer serial = rasterize_depth(sphere, cam, {false});
+  const DepthBuffer threaded = rasterize_depth(sphere, cam, {true});
+  EXPECT_EQ(serial.depth.pixels, threaded.depth.pixels);
+  EXPECT_EQ(serial.face.pixels, threaded.face.pixels);
+  std::size_t covered = 0;
+  for (std::uint32_t f : serial.face.pixels) covered += f != kNoFace;
+  EXPECT_GT(covered, serial.face.size() / 4);
+}
+
 TEST(Raster, CameraInsideASphereSeesItEverywhere) {
   const mesh::TriMesh sphere = mesh::make_icosphere(1.0, 3);
   const Camera cam(camera({0.2, 0.1, 0.3}, {1, 0.5, -1}));

@@ -8,6 +8,9 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
+#include <utility>
+#include <vector>
 
 #include "core/errors.h"
 #include "volume/generate.h"
@@ -294,6 +297,105 @@ TEST(RayCaster, BackgroundPixelsAndTracePixelsAgreeWithTrace) {
     }
   }
   EXPECT_GT(background, 0);
+}
+
+/// A random sparse volume: a few balls of value 1 at random places in a 40³ grid with anisotropic voxels
+/// and an offset origin, so the index-to-world map is not the identity.
+Volume random_sparse_volume(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  DenseSpec spec;
+  spec.dims = {40, 40, 40};
+  spec.voxel_size = {0.5 + u(rng), 0.5 + u(rng), 0.5 + u(rng)};
+  spec.origin_ws = {u(rng) * 10 - 5, u(rng) * 10 - 5, u(rng) * 10 - 5};
+  std::vector<std::pair<Vec3d, double>> balls(2 + std::size_t(u(rng) * 4));
+  for (auto& b : balls) b = {Vec3d{u(rng), u(rng), u(rng)} * 36.0 + Vec3d{2, 2, 2}, 1.0 + 3.0 * u(rng)};
+  return Volume::from_function(spec, [&](int i, int j, int k) {
+    for (const auto& b : balls)
+      if (length(Vec3d{double(i), double(j), double(k)} - b.first) <= b.second) return 1.0f;
+    return 0.0f;
+  });
+}
+
+/// A random view of the volume from outside (or, with `inside`, from a random point in the grid).
+CameraSpec random_view(const Volume& vol, std::mt19937& rng, bool inside) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const GridInfo info = vol.info();
+  const Vec3d centre = (info.bbox_min + info.bbox_max) * 0.5;
+  const double radius = 0.5 * length(info.bbox_max - info.bbox_min);
+  const Vec3d dir = normalize(Vec3d{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5});
+  CameraSpec c;
+  c.width = 48 + int(u(rng) * 16);
+  c.height = 32 + int(u(rng) * 16);
+  c.fov_y_deg = 20 + 50 * u(rng);
+  c.eye = inside ? centre + dir * (0.3 * radius * u(rng)) : centre + dir * (radius * (1.1 + 2.0 * u(rng)));
+  c.target = inside ? centre - dir * radius : centre + Vec3d{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5} * radius;
+  c.up = normalize(Vec3d{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5});
+  return c;
+}
+
+// The fast mask is the exact per-pixel test everywhere, and where either says background the ray
+// accumulates exactly nothing, with or without empty-space skipping; the same for 1 and 2 threads.
+TEST(RayCaster, BackgroundMaskIsTheExactTestOnRandomSparseViews) {
+  std::mt19937 rng(2026);
+  std::size_t background = 0, object = 0;
+  for (int round = 0; round < 12; ++round) {
+    const Volume vol = random_sparse_volume(rng);
+    const bool inside = round % 4 == 3;  // the per-pixel fallback path
+    const CameraSpec cam = random_view(vol, rng, inside);
+    RenderOptions brute = opts(0.5);
+    brute.skip_empty_space = false;
+    const RayCaster caster(vol, step_tf(0.4f, 0.5f), cam, opts(0.5));
+    const RayCaster unskipped(vol, step_tf(0.4f, 0.5f), cam, brute);
+    const Image<std::uint8_t> mask = caster.background_mask();
+    ASSERT_EQ(caster.background_mask(false).pixels, mask.pixels) << "round " << round;
+    for (int y = 0; y < cam.height; ++y)
+      for (int x = 0; x < cam.width; ++x) {
+        ASSERT_EQ(mask(x, y) != 0, caster.pixel_is_background(x, y)) << "round " << round << " pixel " << x << "," << y;
+        if (!mask(x, y)) {
+          ++object;
+          continue;
+        }
+        ++background;
+        const RaySample s = caster.trace(x, y);
+        ASSERT_EQ(s.samples, 0u);
+        ASSERT_EQ(s.color, Rgba{});
+        ASSERT_EQ(unskipped.trace(x, y).color, Rgba{}) << "round " << round << " pixel " << x << "," << y;
+      }
+  }
+  // Both kinds occur often, so the equalities above are not vacuous.
+  EXPECT_GT(background, 5000u);
+  EXPECT_GT(object, 5000u);
+}
+
+// The test follows the blocks, not their bounding box: the ray between two separated balls is
+// background although it crosses the box around both.
+TEST(RayCaster, BackgroundBetweenSeparatedBlocks) {
+  DenseSpec spec;
+  spec.dims = {64, 16, 16};
+  const Volume vol = Volume::from_function(spec, [](int i, int, int) { return i < 8 || i >= 56 ? 1.0f : 0.0f; });
+  CameraSpec cam;
+  cam.width = 33;
+  cam.height = 9;
+  cam.target = {31.5, 7.5, 7.5};
+  cam.eye = cam.target + Vec3d{0, 0, 80};
+  cam.fov_y_deg = 2.0 * std::atan(0.4 * 9.0 / 33.0) * 180.0 / M_PI;  // the image spans x in [0, 64]
+  const RayCaster caster(vol, step_tf(0.4f, 0.5f), cam, opts(0.5));
+  const Image<std::uint8_t> mask = caster.background_mask();
+  EXPECT_TRUE(caster.pixel_is_background(16, 4));
+  EXPECT_EQ(mask(16, 4), 1);
+  EXPECT_FALSE(caster.pixel_is_background(0, 4));  // the left slab covers the image's left edge
+  EXPECT_EQ(mask(0, 4), 0);
+  EXPECT_FALSE(caster.trace(0, 4).color == Rgba{});
+  // An eye inside the left slab: every ray starts in a visible block, none is background.
+  cam.eye = {3.0, 7.5, 7.5};
+  cam.target = {3.0, 7.5, 0.0};
+  const RayCaster inside(vol, step_tf(0.4f, 0.5f), cam, opts(0.5));
+  const Image<std::uint8_t> all_object = inside.background_mask();
+  for (int y = 0; y < cam.height; ++y)
+    for (int x = 0; x < cam.width; ++x) {
+      ASSERT_EQ(all_object(x, y), 0) << x << "," << y;
+      ASSERT_FALSE(inside.pixel_is_background(x, y));
+    }
 }
 
 TEST(RayCaster, NonFiniteVoxelsAndOddCamerasGiveFiniteImages) {
