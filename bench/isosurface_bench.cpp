@@ -14,6 +14,7 @@
 #include "core/json_io.h"
 #include "core/scene.h"
 #include "core/timer.h"
+#include "features/importance.h"
 #include "isosurface/feature_geometry.h"
 #include "isosurface/pipeline.h"
 #include "volume/generate.h"
@@ -92,7 +93,7 @@ void run_case(const Case& c, int runs) {
   const volume::RayCaster caster(c.volume, *c.tf, c.camera);
   const double frame_ms = median_ms(std::max(runs, 3), [&] { volume::render_full(caster); });
   isosurface::FeatureGeometryOptions o;
-  o.view = isosurface::FeatureView{c.camera, 0.5};
+  o.view = isosurface::FeatureView{c.camera, features::ImportanceOptions{}.scale};
   isosurface::FeatureGeometry g;
   const double setup_ms = median_ms(runs, [&] { g = isosurface::build_feature_geometry(c.volume, *c.tf, o); });
   std::printf("  feature set-up %.0f ms (level %d, %zu tris, %zu hidden iso) | full frame %dx%d %.0f ms | ratio %.2f\n",
