@@ -13,16 +13,7 @@ import time
 
 import vtk
 
-
-def smoother(source, iterations):
-    s = vtk.vtkWindowedSincPolyDataFilter()
-    s.SetInputConnection(source.GetOutputPort())
-    s.SetNumberOfIterations(iterations)
-    s.BoundarySmoothingOff()
-    s.FeatureEdgeSmoothingOff()
-    s.NonManifoldSmoothingOff()
-    s.SetPassBand(0.1)
-    return s
+from vtk_reference import flying_edges_filter, raw_reader, windowed_sinc_filter
 
 
 def main(argv):
@@ -31,26 +22,14 @@ def main(argv):
     path, nx, ny, nz = argv[1], int(argv[2]), int(argv[3]), int(argv[4])
     isos = [float(v) for v in argv[5].split(",")]
     iterations, keep, runs = int(argv[6]), float(argv[7]), int(argv[8])
-    reader = vtk.vtkImageReader2()
-    reader.SetFileName(path)
-    reader.SetFileDimensionality(3)
-    reader.SetDataExtent(0, nx - 1, 0, ny - 1, 0, nz - 1)
-    reader.SetDataByteOrderToLittleEndian()
-    reader.SetDataScalarTypeToFloat()
-    reader.Update()
+    reader = raw_reader(path, nx, ny, nz, "f32")
     chains = []
     for iso in isos:
-        fe = vtk.vtkFlyingEdges3D()
-        fe.SetInputConnection(reader.GetOutputPort())
-        fe.SetValue(0, iso)
-        fe.ComputeNormalsOff()
-        fe.ComputeGradientsOff()
-        fe.ComputeScalarsOff()
-        before = smoother(fe, iterations)
+        fe = flying_edges_filter(reader, iso)
         decimate = vtk.vtkQuadricDecimation()
-        decimate.SetInputConnection(before.GetOutputPort())
+        decimate.SetInputConnection(windowed_sinc_filter(fe, iterations).GetOutputPort())
         decimate.SetTargetReduction(1.0 - keep)
-        chains.append((fe, smoother(decimate, iterations)))
+        chains.append((fe, windowed_sinc_filter(decimate, iterations)))
     times = []
     for _ in range(runs):
         start = time.perf_counter()

@@ -32,16 +32,8 @@ def timed(algorithm, runs, stat=statistics.median):
     return stat(times)
 
 
-def flying_edges(path, nx, ny, nz, dtype, iso, runs, pad, threads):
-    """FlyingEdges3D on the whole file and, if pad > 0, also on its interior without the pad-voxel border."""
-    vtk.vtkSMPTools.Initialize(threads)
-    tmp = None
-    if path.endswith(".gz"):
-        tmp = tempfile.NamedTemporaryFile(suffix=".raw", delete=False)
-        with gzip.open(path, "rb") as src:
-            shutil.copyfileobj(src, tmp)
-        tmp.close()
-        path = tmp.name
+def raw_reader(path, nx, ny, nz, dtype):
+    """A headerless little-endian raw grid (u8 or f32, x fastest), read once."""
     reader = vtk.vtkImageReader2()
     reader.SetFileName(path)
     reader.SetFileDimensionality(3)
@@ -52,6 +44,43 @@ def flying_edges(path, nx, ny, nz, dtype, iso, runs, pad, threads):
     else:
         reader.SetDataScalarTypeToFloat()
     reader.Update()
+    return reader
+
+
+def flying_edges_filter(source, iso):
+    """vtkFlyingEdges3D at one iso-value, positions only (what our marching cubes produces)."""
+    fe = vtk.vtkFlyingEdges3D()
+    fe.SetInputConnection(source.GetOutputPort())
+    fe.SetValue(0, iso)
+    fe.ComputeNormalsOff()
+    fe.ComputeGradientsOff()
+    fe.ComputeScalarsOff()
+    return fe
+
+
+def windowed_sinc_filter(source, iterations):
+    """vtkWindowedSincPolyDataFilter with the settings comparable to our Taubin smoothing."""
+    smoother = vtk.vtkWindowedSincPolyDataFilter()
+    smoother.SetInputConnection(source.GetOutputPort())
+    smoother.SetNumberOfIterations(iterations)
+    smoother.BoundarySmoothingOff()
+    smoother.FeatureEdgeSmoothingOff()
+    smoother.NonManifoldSmoothingOff()
+    smoother.SetPassBand(0.1)
+    return smoother
+
+
+def flying_edges(path, nx, ny, nz, dtype, iso, runs, pad, threads):
+    """FlyingEdges3D on the whole file and, if pad > 0, also on its interior without the pad-voxel border."""
+    vtk.vtkSMPTools.Initialize(threads)
+    tmp = None
+    if path.endswith(".gz"):
+        tmp = tempfile.NamedTemporaryFile(suffix=".raw", delete=False)
+        with gzip.open(path, "rb") as src:
+            shutil.copyfileobj(src, tmp)
+        tmp.close()
+        path = tmp.name
+    reader = raw_reader(path, nx, ny, nz, dtype)
     inputs = [reader]
     if pad > 0:
         # The interior as its own image (extent starting at 0), computed before any timing.
@@ -67,12 +96,7 @@ def flying_edges(path, nx, ny, nz, dtype, iso, runs, pad, threads):
         inputs.append(producer)
     results = []
     for source in inputs:
-        fe = vtk.vtkFlyingEdges3D()
-        fe.SetInputConnection(source.GetOutputPort())
-        fe.SetValue(0, iso)
-        fe.ComputeNormalsOff()
-        fe.ComputeGradientsOff()
-        fe.ComputeScalarsOff()
+        fe = flying_edges_filter(source, iso)
         # The minimum, like marching_cubes_bench for ours: on a shared machine it is the least disturbed run.
         results.append((timed(fe, runs, min), fe.GetOutput().GetNumberOfCells()))
     if tmp:
@@ -93,13 +117,7 @@ def read_ply(path):
 
 def windowed_sinc(path, iterations, runs):
     reader = read_ply(path)
-    smoother = vtk.vtkWindowedSincPolyDataFilter()
-    smoother.SetInputConnection(reader.GetOutputPort())
-    smoother.SetNumberOfIterations(iterations)
-    smoother.BoundarySmoothingOff()
-    smoother.FeatureEdgeSmoothingOff()
-    smoother.NonManifoldSmoothingOff()
-    smoother.SetPassBand(0.1)
+    smoother = windowed_sinc_filter(reader, iterations)
     ms = timed(smoother, runs)
     vertices = reader.GetOutput().GetNumberOfPoints()
     print(f"ms={ms:.3f} triangles={smoother.GetOutput().GetNumberOfCells()} vertices={vertices} "

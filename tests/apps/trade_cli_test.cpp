@@ -64,13 +64,20 @@ TEST(CompareCli, MismatchedSizesAndMissingFilesFail) {
   EXPECT_NE(runs[1].err.find("none.exr"), std::string::npos) << runs[1].err;
 }
 
-TEST(SweepCli, WritesOneRowPerModeAndFractionWithTheDocumentedHeader) {
-  const std::string dir = test::make_temp_dir("sweep_cli");
-  ASSERT_EQ(raysift(dir, "make-volume ball --dims 24,24,24 --radius 9 --quiet -o ball.vdb").code, 0);
-  write_json_file(dir + "/scene.json", Json::parse(R"({
-      "volume": "ball.vdb",
-      "transfer_function": {"points": [[0, 1, 0.6, 0.2, 0], [0.45, 1, 0.6, 0.2, 0], [0.55, 1, 0.6, 0.2, 0.6], [1, 1, 0.6, 0.2, 0.6]]},
+/// A fresh directory with ball.vdb (radius 9 in 24^3) and scene.json: a step TF of the given opacity at the
+/// ball's surface value and a 48x32 oblique camera.
+std::string make_ball_scene(const std::string& tag, const std::string& opacity) {
+  const std::string dir = test::make_temp_dir(tag);
+  EXPECT_EQ(raysift(dir, "make-volume ball --dims 24,24,24 --radius 9 --quiet -o ball.vdb").code, 0);
+  write_json_file(dir + "/scene.json", Json::parse(R"({"volume": "ball.vdb", "transfer_function": {"points": )"
+                                                   R"([[0, 1, 0.6, 0.2, 0], [0.45, 1, 0.6, 0.2, 0], [0.55, 1, 0.6, 0.2, )" +
+                                                   opacity + "], [1, 1, 0.6, 0.2, " + opacity + R"(]]},
       "camera": {"eye": [40, 30, 60], "target": [12, 12, 12], "up": [0, 1, 0], "fov_y_deg": 40, "width": 48, "height": 32}})"));
+  return dir;
+}
+
+TEST(SweepCli, WritesOneRowPerModeAndFractionWithTheDocumentedHeader) {
+  const std::string dir = make_ball_scene("sweep_cli", "0.6");
   const CliRun r = raysift(dir, "sweep scene.json --ray-fractions 0.25,0.5 --shading none -o trade.csv");
   ASSERT_EQ(r.code, 0) << r.err;
   std::ifstream in(dir + "/trade.csv");
@@ -115,12 +122,7 @@ std::vector<std::map<std::string, std::string>> read_rows(const std::string& pat
 }
 
 TEST(SweepCli, BudgetStepAndEarlyTerminationRowsAndTheirBadEntries) {
-  const std::string dir = test::make_temp_dir("sweep_cli_knobs");
-  ASSERT_EQ(raysift(dir, "make-volume ball --dims 24,24,24 --radius 9 --quiet -o ball.vdb").code, 0);
-  write_json_file(dir + "/scene.json", Json::parse(R"({
-      "volume": "ball.vdb",
-      "transfer_function": {"points": [[0, 1, 0.6, 0.2, 0], [0.45, 1, 0.6, 0.2, 0], [0.55, 1, 0.6, 0.2, 0.3], [1, 1, 0.6, 0.2, 0.3]]},
-      "camera": {"eye": [40, 30, 60], "target": [12, 12, 12], "up": [0, 1, 0], "fov_y_deg": 40, "width": 48, "height": 32}})"));
+  const std::string dir = make_ball_scene("sweep_cli_knobs", "0.3");
   const CliRun r = raysift(dir, "sweep scene.json --ray-fractions 0.5 --budgets-ms 1000 --time-fractions 0.5 "
                                 "--steps 0.25,2 --early-termination 0.5 --shading none -o trade.csv");
   ASSERT_EQ(r.code, 0) << r.err;
