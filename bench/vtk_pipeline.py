@@ -24,11 +24,14 @@ def main(argv):
     iterations, keep, runs = int(argv[6]), float(argv[7]), int(argv[8])
     reader = raw_reader(path, nx, ny, nz, "f32")
     chains = []
+    keep_alive = []  # VTK's pipeline does not own the Python-side filter objects
     for iso in isos:
         fe = flying_edges_filter(reader, iso)
+        before = windowed_sinc_filter(fe, iterations)
         decimate = vtk.vtkQuadricDecimation()
-        decimate.SetInputConnection(windowed_sinc_filter(fe, iterations).GetOutputPort())
+        decimate.SetInputConnection(before.GetOutputPort())
         decimate.SetTargetReduction(1.0 - keep)
+        keep_alive += [before, decimate]
         chains.append((fe, windowed_sinc_filter(decimate, iterations)))
     times = []
     for _ in range(runs):
