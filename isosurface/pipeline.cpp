@@ -50,7 +50,9 @@ IsosurfaceSet build_isosurfaces(const volume::Volume& volume, const volume::Tran
   std::vector<double> values;
   for (const volume::IsoValue& iso : isos) values.push_back(iso.value);
   timer.reset();
-  std::vector<mesh::TriMesh> raw = volume::extract_isosurfaces(volume, values, options.marching_cubes);
+  volume::MarchingCubesOptions mc = options.marching_cubes;
+  if (!mc.cancel) mc.cancel = options.cancel;
+  std::vector<mesh::TriMesh> raw = volume::extract_isosurfaces(volume, values, mc);
   set.stages.marching_cubes.ms = timer.elapsed_ms();
   std::size_t mc_triangles = 0;
   for (const mesh::TriMesh& m : raw) mc_triangles += m.triangle_count();
@@ -64,6 +66,7 @@ IsosurfaceSet build_isosurfaces(const volume::Volume& volume, const volume::Tran
     if (raw[i].empty()) return;
     check_cancel(options);
     mesh::MeshPrepOptions prep = options.prep;
+    prep.smooth_before.cancel = prep.smooth_after.cancel = options.cancel;
     if (options.total_target_faces > 0)
       prep.decimation.target_faces = share_of_total(options.total_target_faces, raw[i].triangle_count(), mc_triangles);
     prepared[i] = mesh::prepare_mesh(raw[i], prep);

@@ -133,6 +133,7 @@ TriMesh taubin_smooth(const TriMesh& mesh, const SmoothingOptions& options) {
     std::swap(current, next);
   };
   for (int it = 0; it < options.iterations; ++it) {
+    if (options.cancel && options.cancel->load(std::memory_order_relaxed)) throw Cancelled("smoothing cancelled");
     pass(options.lambda);
     if (options.mu != 0) pass(options.mu);
   }

@@ -3,6 +3,8 @@
 /// pass computes all displacements from the current positions, then moves every vertex, so the result does
 /// not depend on the vertex order or the thread count. Boundary, non-manifold and isolated vertices stay
 /// fixed. With mu = 0 it is plain Laplacian smoothing (one λ pass per iteration), the shrinking reference.
+#include <atomic>
+
 #include "mesh/tri_mesh.h"
 
 namespace raysift::mesh {
@@ -22,6 +24,8 @@ struct SmoothingOptions {
   double mu = -0.51;     ///< inflating step: mu < −lambda and mu >= −1, or exactly 0 for plain Laplacian smoothing
   SmoothingWeights weights = SmoothingWeights::Uniform;
   bool threaded = true;  ///< false = serial path (same result)
+  /// Checked before every iteration; when it becomes true taubin_smooth throws Cancelled.
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 /// Cap on one cotangent weight: cot 1° ≈ 57, i.e. angles below 1° count as 1°.
@@ -29,7 +33,7 @@ inline constexpr double kMaxCotangent = 57.0;
 
 /// Returns the smoothed mesh (same connectivity). Cost: O(iterations · (V + F)).
 /// \throw InvalidInput for out-of-range options (the message names the option), or a mesh failing
-///        validate_mesh() (non-finite position, index out of range).
+///        validate_mesh() (non-finite position, index out of range); Cancelled when the cancel flag is set.
 TriMesh taubin_smooth(const TriMesh& mesh, const SmoothingOptions& options = {});
 
 }  // namespace raysift::mesh

@@ -119,3 +119,19 @@ TEST(TaubinSmooth, BadOptionsThrow) {
 
 }  // namespace
 }  // namespace raysift::mesh
+
+namespace raysift::mesh {
+namespace {
+
+TEST(Smoothing, CancelFlagStopsBeforeTheFirstIteration) {
+  const std::atomic<bool> cancel{true};
+  SmoothingOptions o;
+  o.cancel = &cancel;
+  EXPECT_THROW(taubin_smooth(make_icosphere(1.0, 2), o), Cancelled);
+  const std::atomic<bool> go{false};
+  o.cancel = &go;
+  EXPECT_EQ(taubin_smooth(make_icosphere(1.0, 2), o).vertex_count(), make_icosphere(1.0, 2).vertex_count());
+}
+
+}  // namespace
+}  // namespace raysift::mesh
