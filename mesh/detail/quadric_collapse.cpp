@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "mesh/mesh_analysis.h"
@@ -14,7 +15,7 @@ using Face = std::array<std::uint32_t, 3>;
 constexpr std::uint32_t kNone = ~std::uint32_t(0);
 /// A collapse may not leave a face below this quality (2 sqrt(3) |cross| / sum of squared edges, 1 =
 /// equilateral) unless that face was already worse.
-constexpr double kMinQuality = 0.05;
+constexpr double kMinQuality = 0.01;
 
 /// Symmetric 4x4 plane quadric, upper triangle (xx xy xz xw yy yz yw zz zw ww), plus the area it covers.
 struct Quadric {
@@ -69,15 +70,24 @@ double quality(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& n) {
 }
 
 /// A heap entry: collapse `removed` into `kept`, valid while both vertices still have the stamped versions.
+/// key = the cost as float bits (monotonic for costs >= 0) above the removed vertex's id: one integer
+/// comparison orders by cost, ties by id (the heap compares nothing else; it is the hot loop).
 struct Candidate {
-  double cost;
-  std::uint32_t removed, kept, removed_version, kept_version;
+  std::uint64_t key;
+  std::uint32_t kept, removed_version, kept_version;
+  std::uint32_t removed() const { return std::uint32_t(key); }
 };
 
-/// Heap order: lowest cost first, ties by vertex ids, so the result does not depend on insertion order.
-bool later(const Candidate& a, const Candidate& b) {
-  if (a.cost != b.cost) return a.cost > b.cost;
-  return a.removed != b.removed ? a.removed > b.removed : a.kept > b.kept;
+struct Later {
+  bool operator()(const Candidate& a, const Candidate& b) const { return a.key > b.key; }
+};
+constexpr Later later;
+
+std::uint64_t heap_key(double cost, std::uint32_t removed) {
+  const float c = float(cost);
+  std::uint32_t bits;
+  std::memcpy(&bits, &c, sizeof bits);
+  return std::uint64_t(bits) << 32 | removed;
 }
 
 class Collapser {
@@ -117,14 +127,15 @@ class Collapser {
       std::pop_heap(heap_.begin(), heap_.end(), later);
       const Candidate c = heap_.back();
       heap_.pop_back();
-      if (version_[c.removed] != c.removed_version || version_[c.kept] != c.kept_version) continue;
-      const Vec3d p = placement(c.removed, c.kept);
-      if (!can_collapse(c.removed, c.kept, p)) {
-        park(c.removed, c.kept);
-        park(c.kept, c.removed);
+      const std::uint32_t removed = c.removed();
+      if (version_[removed] != c.removed_version || version_[c.kept] != c.kept_version) continue;
+      const Vec3d p = placement(removed, c.kept);
+      if (!can_collapse(removed, c.kept, p)) {
+        park(removed, c.kept);
+        park(c.kept, removed);
         continue;
       }
-      collapse(c.removed, c.kept, p);
+      collapse(removed, c.kept, p);
       ++result.collapses;
     }
     result.locked_vertices = std::size_t(std::count(locked_.begin(), locked_.end(), 1));
@@ -152,7 +163,7 @@ class Collapser {
     const double cost = q.error(placement(removed, kept));
     const double limit = options_.max_rms_error;
     if (limit > 0 && cost > limit * limit * q.area) return;
-    heap_.push_back({cost, removed, kept, version_[removed], version_[kept]});
+    heap_.push_back({heap_key(cost, removed), kept, version_[removed], version_[kept]});
     if (heapify) std::push_heap(heap_.begin(), heap_.end(), later);
   }
 
@@ -174,14 +185,15 @@ class Collapser {
   }
 
   /// Link condition for the interior edge (u, v): its two faces' opposite vertices are the only common
-  /// neighbours, and each keeps at least three faces (else a tetrahedron would fold flat).
+  /// neighbours, and each keeps at least three faces if interior (else a tetrahedron would fold flat), one if
+  /// locked (a border vertex may end in a single face).
   bool link_condition(std::uint32_t u, std::uint32_t v) {
     int shared = 0;
     for (const std::uint32_t f : incident_[u])
       if (has(faces_[f], v)) {
         ++shared;
         for (const std::uint32_t w : faces_[f])
-          if (w != u && w != v && incident_[w].size() <= 3) return false;
+          if (w != u && w != v && incident_[w].size() <= (locked_[w] ? 1u : 3u)) return false;
       }
     if (shared != 2) return false;
     neighbours(u, ring_u_);
