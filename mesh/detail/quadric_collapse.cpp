@@ -69,19 +69,59 @@ double quality(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& n) {
   return sum > 0 ? 2 * std::sqrt(3.0) * length(n) / sum : 0;
 }
 
-/// A heap entry: collapse `removed` into `kept`, valid while both vertices still have the stamped versions.
-/// key = the cost as float bits (monotonic for costs >= 0) above the removed vertex's id: one integer
-/// comparison orders by cost, ties by id (the heap compares nothing else; it is the hot loop).
+/// A heap entry (16 bytes: the heap is memory-bound): collapse `removed` into `kept`. key = the cost as float
+/// bits (monotonic for costs >= 0) above the removed vertex's id: one integer comparison orders by cost, ties
+/// by id. Valid while the sum of both vertices' versions is unchanged (versions only grow, so an unchanged sum
+/// means both are unchanged).
 struct Candidate {
   std::uint64_t key;
-  std::uint32_t kept, removed_version, kept_version;
+  std::uint32_t kept, versions;
   std::uint32_t removed() const { return std::uint32_t(key); }
 };
 
-struct Later {
-  bool operator()(const Candidate& a, const Candidate& b) const { return a.key > b.key; }
+/// Min-heap with 4 children per node: half the depth of a binary heap, siblings on adjacent cache lines (the
+/// heap was the hot spot: most pops are stale entries).
+class QuadHeap {
+ public:
+  bool empty() const { return a_.empty(); }
+  /// Appends without ordering; call heapify() before the next pop.
+  void append(const Candidate& c) { a_.push_back(c); }
+  void heapify() {
+    for (std::size_t i = a_.size() / 4 + 1; i-- > 0;) sift_down(i);
+  }
+  void push(const Candidate& c) {
+    std::size_t i = a_.size();
+    a_.push_back(c);
+    while (i > 0 && a_[(i - 1) / 4].key > c.key) a_[i] = a_[(i - 1) / 4], i = (i - 1) / 4;
+    a_[i] = c;
+  }
+  Candidate pop() {
+    const Candidate top = a_[0];
+    a_[0] = a_.back();
+    a_.pop_back();
+    if (!a_.empty()) sift_down(0);
+    return top;
+  }
+
+ private:
+  void sift_down(std::size_t i) {
+    const Candidate c = a_[i];
+    const std::size_t n = a_.size();
+    for (;;) {
+      const std::size_t first = 4 * i + 1;
+      if (first >= n) break;
+      std::size_t best = first;
+      for (std::size_t j = first + 1; j < std::min(first + 4, n); ++j)
+        if (a_[j].key < a_[best].key) best = j;
+      if (a_[best].key >= c.key) break;
+      a_[i] = a_[best];
+      i = best;
+    }
+    a_[i] = c;
+  }
+
+  std::vector<Candidate> a_;
 };
-constexpr Later later;
 
 std::uint64_t heap_key(double cost, std::uint32_t removed) {
   const float c = float(cost);
@@ -124,11 +164,9 @@ class Collapser {
     // An empty heap means every edge left is refused in the current state (refused ones are parked until
     // their neighbourhood changes), so there is nothing more to try.
     while (alive_faces_ > options_.target_faces && !heap_.empty()) {
-      std::pop_heap(heap_.begin(), heap_.end(), later);
-      const Candidate c = heap_.back();
-      heap_.pop_back();
+      const Candidate c = heap_.pop();
       const std::uint32_t removed = c.removed();
-      if (version_[removed] != c.removed_version || version_[c.kept] != c.kept_version) continue;
+      if (version_[removed] + version_[c.kept] != c.versions) continue;
       const Vec3d p = placement(removed, c.kept);
       if (!can_collapse(removed, c.kept, p)) {
         park(removed, c.kept);
@@ -146,13 +184,12 @@ class Collapser {
  private:
   /// Every interior edge once (a -> b with a < b in some face; a consistently oriented manifold has it once).
   void fill_heap() {
-    heap_.clear();
     for (const Face& t : faces_) {
       if (t[0] == kNone) continue;
       for (int k = 0; k < 3; ++k)
         if (t[k] < t[(k + 1) % 3]) push_edge(t[k], t[(k + 1) % 3]);
     }
-    std::make_heap(heap_.begin(), heap_.end(), later);
+    heap_.heapify();
   }
 
   /// The kept end is the locked one (a locked vertex neither moves nor goes), else the lower id.
@@ -163,8 +200,9 @@ class Collapser {
     const double cost = q.error(placement(removed, kept));
     const double limit = options_.max_rms_error;
     if (limit > 0 && cost > limit * limit * q.area) return;
-    heap_.push_back({heap_key(cost, removed), kept, version_[removed], version_[kept]});
-    if (heapify) std::push_heap(heap_.begin(), heap_.end(), later);
+    const Candidate c{heap_key(cost, removed), kept, version_[removed] + version_[kept]};
+    if (heapify) heap_.push(c);
+    else heap_.append(c);
   }
 
   Vec3d placement(std::uint32_t removed, std::uint32_t kept) const {
@@ -298,7 +336,7 @@ class Collapser {
   std::vector<std::vector<std::uint32_t>> parked_;  ///< vertex -> other ends of its refused collapses
   std::vector<std::uint32_t> version_;  ///< bumped when a vertex moves or goes: older heap entries are stale
   std::vector<char> locked_;
-  std::vector<Candidate> heap_;
+  QuadHeap heap_;
   std::vector<std::uint32_t> ring_u_, ring_v_;  ///< scratch
   std::size_t alive_faces_;
   CollapseOptions options_;
