@@ -167,7 +167,7 @@ class Collapser {
       const Candidate c = heap_.pop();
       const std::uint32_t removed = c.removed();
       if (version_[removed] + version_[c.kept] != c.versions) continue;
-      const Vec3d p = placement(removed, c.kept);
+      const Vec3d p = placement(removed, c.kept, quadrics_[removed] + quadrics_[c.kept]);
       if (!can_collapse(removed, c.kept, p)) {
         park(removed, c.kept);
         park(c.kept, removed);
@@ -197,7 +197,7 @@ class Collapser {
     if (locked_[a] && locked_[b]) return;
     const std::uint32_t kept = locked_[a] || (!locked_[b] && a < b) ? a : b, removed = kept == a ? b : a;
     const Quadric q = quadrics_[a] + quadrics_[b];
-    const double cost = q.error(placement(removed, kept));
+    const double cost = q.error(placement(removed, kept, q));
     const double limit = options_.max_rms_error;
     if (limit > 0 && cost > limit * limit * q.area) return;
     const Candidate c{heap_key(cost, removed), kept, version_[removed] + version_[kept]};
@@ -205,9 +205,9 @@ class Collapser {
     else heap_.append(c);
   }
 
-  Vec3d placement(std::uint32_t removed, std::uint32_t kept) const {
-    if (locked_[kept]) return positions_[kept];
-    return optimal_position(quadrics_[removed] + quadrics_[kept], positions_[removed], positions_[kept]);
+  /// `q` = the summed quadric of both ends.
+  Vec3d placement(std::uint32_t removed, std::uint32_t kept, const Quadric& q) const {
+    return locked_[kept] ? positions_[kept] : optimal_position(q, positions_[removed], positions_[kept]);
   }
 
   static bool has(const Face& t, std::uint32_t v) { return t[0] == v || t[1] == v || t[2] == v; }
