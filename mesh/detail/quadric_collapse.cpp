@@ -173,11 +173,11 @@ class Collapser {
     std::size_t swept_size = 0;
     const auto stale = [&](const Candidate& c) { return version_[c.removed()] + version_[c.kept] != c.versions; };
     while (alive_faces_ > options_.target_faces && !heap_.empty()) {
-      // Most entries go stale (every collapse re-pushes the kept vertex's edges): once they are a good part
-      // of the heap (a closed mesh has 1.5 edges per face), drop them in one sweep instead of popping each.
+      // Most entries go stale (every collapse re-pushes the kept vertex's edges): once the heap exceeds 1.6
+      // entries per face (a closed mesh has 1.5 edges per face), drop them in one sweep instead of popping each.
       // Asking for F/2 entries added since the last sweep keeps a sweep's O(heap) cost per entry constant
       // even if few are stale.
-      if (heap_.size() > 2 * alive_faces_ && heap_.size() >= swept_size + alive_faces_ / 2) {
+      if (heap_.size() > alive_faces_ * 8 / 5 && heap_.size() >= swept_size + alive_faces_ / 2) {
         heap_.compact(stale);
         swept_size = heap_.size();
       }
