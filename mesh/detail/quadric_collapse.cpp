@@ -150,7 +150,8 @@ class Collapser {
     version_.assign(n, 0);
     locked_.assign(n, 0);
     const std::vector<VertexKind> kinds = classify_vertices(mesh);
-    for (std::size_t v = 0; v < n; ++v) locked_[v] = kinds[v] != VertexKind::Interior;
+    for (std::size_t v = 0; v < n; ++v)
+      locked_[v] = kinds[v] == VertexKind::Boundary || kinds[v] == VertexKind::NonManifold;
     for (std::uint32_t f = 0; f < faces_.size(); ++f) {
       const Face& t = faces_[f];
       if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2])

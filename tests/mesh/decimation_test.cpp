@@ -246,6 +246,7 @@ TEST(Decimation, OpenCylinderKeepsEveryBorderVertex) {
     return out;
   };
   EXPECT_EQ(border(r.mesh), border(cylinder));
+  EXPECT_EQ(r.locked_vertices, border(cylinder).size());
   EXPECT_EQ(analyze_mesh(r.mesh).euler_characteristic, 0);
   EXPECT_LT(r.mesh.triangle_count(), cylinder.triangle_count() / 2);
 }
