@@ -1,6 +1,6 @@
 // Mesh preparation on marching-cubes output (bundled engine CT iso 80 and 150, bundled MRI iso 60, 256^3
 // Gaussian blobs iso 0.5), in one run: our Taubin smoothing vs OpenMesh JacobiLaplaceSmootherT and VTK
-// vtkWindowedSincPolyDataFilter (vertex-iterations per second), and our meshoptimizer decimation vs VTK
+// vtkWindowedSincPolyDataFilter (vertex-iterations per second), and our quadric-collapse decimation vs VTK
 // vtkQuadricDecimation to 10% of the faces: time, ratio, and the one-sided Hausdorff distances of both results
 // measured by the same C++ code (VTK's result is read back from a PLY the python script writes).
 // Usage: mesh_prep_bench [ITERATIONS] (default 20 smoothing iterations)
@@ -42,8 +42,8 @@ std::pair<double, long> vtk(const std::string& mode, const std::string& ply, lon
   return {ms, triangles};
 }
 
-/// Points on a simplified surface: its vertices plus each triangle's centroid and edge midpoints. Our output
-/// vertices are input vertices (distance 0), so vertices alone would say nothing about the triangles between.
+/// Points on a simplified surface: its vertices plus each triangle's centroid and edge midpoints (vertices
+/// alone would say nothing about the triangles between).
 std::vector<Vec3f> surface_samples(const mesh::TriMesh& m) {
   std::vector<Vec3f> out = m.positions;
   for (const auto& t : m.triangles) {
@@ -86,10 +86,11 @@ void bench_decimation(const mesh::TriMesh& m, const std::string& ply) {
   const Quality q = quality(m, ours.mesh);
   std::printf("  input: watertight %d, euler %ld, %zu components\n", int(in.is_watertight()),
               long(in.euler_characteristic), in.components);
-  std::printf("  decimation (ours = meshopt + guard) to %zu faces %9.1f ms  %6.2f M input triangles/s\n", faces, dec_ms,
-              double(m.triangle_count()) / dec_ms * 1e-3);
-  std::printf("    guard: %d meshopt re-runs, %zu triangles frozen, %zu components to OpenMesh\n", ours.retries,
-              ours.frozen_faces, ours.openmesh_components);
+  std::printf("  decimation (ours = quadric collapse) to %zu faces %9.1f ms  %6.2f M input triangles/s\n", faces,
+              dec_ms, double(m.triangle_count()) / dec_ms * 1e-3);
+  std::printf("    %zu collapses, %zu locked vertices, topology kept (watertight and euler as input) %d\n",
+              ours.collapses, ours.locked_vertices,
+              int(q.watertight == in.is_watertight() && q.euler == long(in.euler_characteristic)));
   std::printf("    Hausdorff simplified->original %.4f, original->simplified %.4f, watertight %d, euler %ld\n",
               q.to_original, q.from_original, int(q.watertight), q.euler);
   const std::string vtk_ply = ply + ".vtk.ply";
@@ -151,9 +152,8 @@ void bench(const std::string& label, const mesh::TriMesh& m, int iterations) {
 
 }  // namespace
 
-/// Throughput of one plain meshopt_simplify call to 10 % on a 5 M-triangle closed surface (the size of three
-/// full-resolution MRI iso-surfaces). Not decimate(): on this torus meshopt leaves non-manifold edges that 8
-/// guarded runs did not clear, so the OpenMesh fallback took 269 s (docs/isosurface.md).
+/// Throughput of one plain meshopt_simplify call (the keep_topology = false path) to 10 % on a 5 M-triangle
+/// closed surface (the size of three full-resolution MRI iso-surfaces).
 void throughput_note() {
   const mesh::TriMesh torus = mesh::make_torus(100.0, 30.0, 2048, 1280);
   std::vector<unsigned> kept(3 * torus.triangle_count());
