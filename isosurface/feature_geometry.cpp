@@ -54,8 +54,8 @@ PipelineOptions pipeline_options(const FeatureGeometryOptions& o, double max_err
   p.prep.smooth_before.iterations = p.prep.smooth_after.iterations = o.smooth_iterations;
   p.prep.decimation.ratio = o.decimate_ratio;
   p.prep.decimation.max_error = max_error;
-  // Lines need positions, not a guaranteed manifold: meshopt alone (the topology guard cost 5-20x the
-  // simplification itself on the engine CT and the MRI).
+  // Lines need positions, not a guaranteed manifold: one meshopt run, 2-4x faster than the topology-safe
+  // quadric collapse on marching-cubes surfaces.
   p.prep.decimation.keep_topology = false;
   p.cancel = o.cancel;
   p.progress = o.progress;
