@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "apps/raysift/command.h"
+#include "apps/raysift/sampling_flags.h"
 #include "apps/raysift/volume_input.h"
 #include "core/file_util.h"
 #include "core/image.h"
@@ -329,7 +330,7 @@ RegisterCommand reg(
                      "prioritized: line classes for the importance (contours,silhouettes,suggestive,highlights,"
                      "ridges,valleys|all) or none (pattern-only control)")
           ->capture_default_str();
-      sub.add_option("--alpha", opt->alpha, "prioritized: priority mapping a00,a10,a01,a11,a20,a02 (default 0.5,0.5,0.5,0.5,0,0; recommended 0.5,0.1,0.5,0.1,0,0)");
+      sub.add_option("--alpha", opt->alpha, "prioritized: " + alpha_flag_help());
       sub.add_option("--progressive", opt->progressive,
                      "prioritized: render N progressive frames of a still camera, write the last")
           ->capture_default_str();

@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "apps/raysift/command.h"
+#include "apps/raysift/sampling_flags.h"
 #include "apps/raysift/run_program.h"
 #include "core/file_util.h"
 #include "core/scene.h"
@@ -95,7 +96,7 @@ RegisterCommand reg(
                      "also full renders at these early-termination opacities, (0, 1]");
       sub.add_option("--plot", opt->plot, "also draw error vs frame time for every mode and knob (PNG)");
       sub.add_option("--features", opt->features, "line classes of the prioritized rows")->capture_default_str();
-      sub.add_option("--alpha", opt->alpha, "priority mapping a00,a10,a01,a11,a20,a02 (default 0.5,0.5,0.5,0.5,0,0; recommended 0.5,0.1,0.5,0.1,0,0)");
+      sub.add_option("--alpha", opt->alpha, alpha_flag_help());
       sub.add_option("--feature-mesh", opt->feature_mesh, "prepared feature mesh instead of the iso-surfaces");
       sub.add_option("--shading", opt->shading, "none|phong")->capture_default_str();
       sub.add_option("--width", opt->width, "image width (default: the scene camera's)");
