@@ -8,8 +8,25 @@
 
 #include "core/errors.h"
 #include "core/timer.h"
+#include "volume/iso_values.h"
 
 namespace raysift::sampling {
+
+namespace {
+
+/// True when the TF's opacity stays at or below the iso choice's threshold at every value the volume holds (the
+/// ends of its range and the control points inside it bound the piecewise-linear opacity), i.e. when
+/// volume::select_iso_values would find no surface.
+bool transparent_over_data(const volume::Volume& volume, const volume::TransferFunction& tf) {
+  const double threshold = volume::IsoValueOptions{}.min_opacity;
+  const volume::GridInfo info = volume.info();
+  if (tf.opacity(info.value_min) > threshold || tf.opacity(info.value_max) > threshold) return false;
+  for (const volume::TfPoint& p : tf.points())
+    if (p.x > info.value_min && p.x < info.value_max && p.a > threshold) return false;
+  return true;
+}
+
+}  // namespace
 
 features::LineClassSet parse_feature_list(const std::string& list) {
   if (list == "none") return {};
@@ -82,7 +99,10 @@ SampledRender render_sampled_volume(const volume::Volume& volume, const volume::
   validate(request.sampling);
   if (request.progressive_frames < 0)
     throw InvalidInput("--progressive must be >= 0, got " + std::to_string(request.progressive_frames));
-  const bool uses_features = request.sampling.mode == SamplingMode::Prioritized && !request.features.classes.is_empty();
+  const bool wants_features = request.sampling.mode == SamplingMode::Prioritized && !request.features.classes.is_empty();
+  // A TF that hides every value leaves no surface for lines (and an empty frame): render without them.
+  const bool skip_features = wants_features && request.feature_mesh.empty() && transparent_over_data(volume, tf);
+  const bool uses_features = wants_features && !skip_features;
   FeatureGeometry geometry;
   if (uses_features && request.feature_mesh.empty()) {
     FeatureGeometryOptions options = request.geometry;
@@ -94,6 +114,7 @@ SampledRender render_sampled_volume(const volume::Volume& volume, const volume::
   const FeatureGeometry* geometry_ptr = uses_features ? &geometry : nullptr;
 
   SampledRender out;
+  out.features_skipped = skip_features;
   Json& stats = out.stats;
   stats["mode"] = sampling_mode_name(request.sampling.mode);
   stats["features"] = uses_features ? Json("lines") : Json("none");

@@ -78,6 +78,8 @@ struct SampledRender {
   ImageRGBA image;
   Json stats;
   bool budget_too_small = false;
+  /// The TF is transparent over the whole data range: no surface feeds the lines, the frame used none.
+  bool features_skipped = false;
 };
 
 /// \throw InvalidInput for invalid options (see validate()), a progressive request outside the

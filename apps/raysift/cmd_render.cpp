@@ -71,6 +71,9 @@ using ModeFunction = std::function<ModeOutput(const RenderInputs&, const volume:
 // Prioritized and subsample rendering (sampling/volume_sampling.h); the request was built from the flags.
 ModeOutput sampled_mode(const RenderInputs& in, const volume::RayCaster& caster, const CommonOptions& common) {
   sampling::SampledRender r = sampling::render_sampled_volume(in.volume, *in.tf, caster, in.sampled);
+  if (r.features_skipped && !common.quiet)
+    std::cerr << "raysift: warning: the transfer function is transparent over the whole data range; no surface feeds "
+                 "the feature lines, rendering without them\n";
   if (r.budget_too_small && !common.quiet)
     std::cerr << "raysift: warning: --budget-ms " << in.sampled.sampling.budget_ms
               << " is below the time of the level-0 pattern plus reconstruction; only level 0 was traced\n";

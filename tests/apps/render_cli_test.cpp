@@ -185,3 +185,20 @@ TEST(RenderCli, FeatureMeshOutsideTheVolumeNamesBothBoxes) {
 
 }  // namespace
 }  // namespace raysift
+
+namespace raysift {
+namespace {
+
+TEST(RenderCli, TransparentTfRendersThePrioritizedFrameWithoutLinesAndWarns) {
+  const std::string dir = make_ball_dir("render_transparent_tf");
+  write_json_file(dir + "/clear.json", Json::parse(R"({"points": [[0,1,1,1,0],[1,1,1,1,0]]})"));
+  const CliRun r = raysift(dir, "render ball.vdb --tf clear.json --width 40 --height 30 --mode prioritized "
+                                "-o out.exr --stats s.json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("transparent over the whole data range"), std::string::npos) << r.err;
+  EXPECT_EQ(read_json_file(dir + "/s.json")["features"], "none");
+  for (const Rgba& p : read_image_rgba(dir + "/out.exr").pixels) ASSERT_EQ(p, (Rgba{0, 0, 0, 0}));
+}
+
+}  // namespace
+}  // namespace raysift
