@@ -26,6 +26,28 @@ bool transparent_over_data(const volume::Volume& volume, const volume::TransferF
   return true;
 }
 
+/// The feature geometry a request asks for: the prepared mesh file, or built for the caster's view.
+FeatureGeometry request_geometry(const volume::Volume& volume, const volume::TransferFunction& tf,
+                                 const volume::RayCaster& caster, const SampledRenderRequest& request) {
+  if (!request.feature_mesh.empty()) return load_feature_geometry(request.feature_mesh, &volume);
+  FeatureGeometryOptions options = request.geometry;
+  if (!options.view) options.view = isosurface::FeatureView{caster.camera().spec(), request.features.importance.scale};
+  return build_feature_geometry(volume, tf, options, request.feature_cache);
+}
+
+Json geometry_stats(const FeatureGeometry& geometry) {
+  const isosurface::StageTimes& t = geometry.stages;
+  return {{"feature_triangles", geometry.mesh.triangles.size()},
+          {"iso_values", geometry.iso_values},
+          {"feature_coarsening", geometry.coarsening},
+          {"hidden_iso_values", geometry.hidden_iso_values},
+          {"feature_cache_hit", geometry.from_cache},
+          {"features_setup_ms",
+           {{"level", geometry.level_ms}, {"probe", geometry.probe_ms}, {"iso_choice", t.iso_choice_ms},
+            {"marching_cubes", t.marching_cubes.ms}, {"smooth_before", t.smooth_before.ms},
+            {"decimate", t.decimate.ms}, {"smooth_after", t.smooth_after.ms}, {"curvature", geometry.curvature_ms}}}};
+}
+
 }  // namespace
 
 features::LineClassSet parse_feature_list(const std::string& list) {
@@ -103,14 +125,7 @@ SampledRender render_sampled_volume(const volume::Volume& volume, const volume::
   // A TF that hides every value leaves no surface for lines (and an empty frame): render without them.
   const bool skip_features = wants_features && request.feature_mesh.empty() && transparent_over_data(volume, tf);
   const bool uses_features = wants_features && !skip_features;
-  FeatureGeometry geometry;
-  if (uses_features && request.feature_mesh.empty()) {
-    FeatureGeometryOptions options = request.geometry;
-    if (!options.view) options.view = isosurface::FeatureView{caster.camera().spec(), request.features.importance.scale};
-    geometry = build_feature_geometry(volume, tf, options, request.feature_cache);
-  } else if (uses_features) {
-    geometry = load_feature_geometry(request.feature_mesh, &volume);
-  }
+  const FeatureGeometry geometry = uses_features ? request_geometry(volume, tf, caster, request) : FeatureGeometry{};
   const FeatureGeometry* geometry_ptr = uses_features ? &geometry : nullptr;
 
   SampledRender out;
@@ -118,18 +133,7 @@ SampledRender render_sampled_volume(const volume::Volume& volume, const volume::
   Json& stats = out.stats;
   stats["mode"] = sampling_mode_name(request.sampling.mode);
   stats["features"] = uses_features ? Json("lines") : Json("none");
-  if (uses_features) {
-    stats["feature_triangles"] = geometry.mesh.triangles.size();
-    stats["iso_values"] = geometry.iso_values;
-    stats["feature_coarsening"] = geometry.coarsening;
-    stats["hidden_iso_values"] = geometry.hidden_iso_values;
-    const isosurface::StageTimes& t = geometry.stages;
-    stats["features_setup_ms"] = {{"level", geometry.level_ms},         {"probe", geometry.probe_ms},
-                                  {"iso_choice", t.iso_choice_ms},       {"marching_cubes", t.marching_cubes.ms},
-                                  {"smooth_before", t.smooth_before.ms}, {"decimate", t.decimate.ms},
-                                  {"smooth_after", t.smooth_after.ms},   {"curvature", geometry.curvature_ms}};
-    stats["feature_cache_hit"] = geometry.from_cache;
-  }
+  if (uses_features) stats.update(geometry_stats(geometry));
   auto fill = [&](const SampledFrame& f, double importance_ms, double total_ms, std::uint64_t samples) {
     stats["rays_traced"] = f.rays_traced;
     stats["samples"] = samples;
