@@ -137,6 +137,58 @@ std::uint64_t heap_key(double cost, std::uint32_t removed) {
   return std::uint64_t(bits) << 32 | removed;
 }
 
+/// vertex -> its live faces, in one flat pool (no per-vertex allocation in the collapse loop): each vertex owns
+/// a slot of `cap` entries; a list that outgrows its slot moves to the end of the pool with twice the room
+/// (the old slot is abandoned: the pool stays within a small multiple of 3F).
+class Incidence {
+ public:
+  void init(const std::vector<Face>& faces, std::size_t vertices) {
+    slots_.assign(vertices, Slot{});
+    for (const Face& t : faces)
+      for (const std::uint32_t v : t) ++slots_[v].cap;
+    std::uint32_t offset = 0;
+    for (Slot& s : slots_) s.begin = offset, s.cap += 2, offset += s.cap;  // slack for the first merges
+    pool_.resize(offset);
+    for (std::uint32_t f = 0; f < faces.size(); ++f)
+      for (const std::uint32_t v : faces[f]) push(v, f);
+  }
+  const std::uint32_t* begin(std::uint32_t v) const { return pool_.data() + slots_[v].begin; }
+  const std::uint32_t* end(std::uint32_t v) const { return begin(v) + slots_[v].size; }
+  std::uint32_t size(std::uint32_t v) const { return slots_[v].size; }
+  void push(std::uint32_t v, std::uint32_t f) {
+    Slot& s = slots_[v];
+    if (s.size == s.cap) {
+      const std::uint32_t moved = std::uint32_t(pool_.size());
+      pool_.resize(pool_.size() + 2 * s.cap);
+      std::copy_n(pool_.data() + s.begin, s.size, pool_.data() + moved);
+      s.begin = moved, s.cap *= 2;
+    }
+    pool_[s.begin + s.size++] = f;
+  }
+  /// Removes f from v's list (order not kept). \pre f is in it.
+  void erase(std::uint32_t v, std::uint32_t f) {
+    Slot& s = slots_[v];
+    std::uint32_t* list = pool_.data() + s.begin;
+    *std::find(list, list + s.size, f) = list[s.size - 1];
+    --s.size;
+  }
+  void clear(std::uint32_t v) { slots_[v].size = 0; }
+
+ private:
+  struct Slot {
+    std::uint32_t begin = 0, size = 0, cap = 0;
+  };
+  std::vector<Slot> slots_;
+  std::vector<std::uint32_t> pool_;
+};
+
+/// A range-for view of one vertex's faces.
+struct FaceRange {
+  const std::uint32_t *b, *e;
+  const std::uint32_t* begin() const { return b; }
+  const std::uint32_t* end() const { return e; }
+};
+
 class Collapser {
  public:
   Collapser(const TriMesh& mesh, const CollapseOptions& options)
@@ -145,7 +197,8 @@ class Collapser {
     positions_.reserve(n);
     for (const Vec3f& p : mesh.positions) positions_.push_back(Vec3d(p));
     quadrics_.resize(n);
-    incident_.resize(n);
+    incident_.init(faces_, n);
+    mark_.assign(n, 0);
     parked_.resize(n);
     version_.assign(n, 0);
     locked_.assign(n, 0);
@@ -156,7 +209,6 @@ class Collapser {
       const Face& t = faces_[f];
       if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
         for (const std::uint32_t v : t) locked_[v] = 1;
-      for (const std::uint32_t v : t) incident_[v].push_back(f);
       const Vec3d a = positions_[t[0]], n2 = cross(positions_[t[1]] - a, positions_[t[2]] - a);
       const double len = length(n2);
       if (!(len > 0)) continue;
@@ -229,15 +281,24 @@ class Collapser {
   }
 
   static bool has(const Face& t, std::uint32_t v) { return t[0] == v || t[1] == v || t[2] == v; }
+  FaceRange faces_of(std::uint32_t v) const { return {incident_.begin(v), incident_.end(v)}; }
+
+  /// Calls visit(w) once for each distinct neighbour w of v, in no particular order. Each pass takes a fresh mark,
+  /// so no clearing is needed.
+  template <typename Visit>
+  void for_each_neighbour(std::uint32_t v, Visit visit) {
+    const std::uint64_t seen = next_mark();
+    for (const std::uint32_t f : faces_of(v))
+      for (const std::uint32_t w : faces_[f])
+        if (w != v && mark_[w] != seen) mark_[w] = seen, visit(w);
+  }
+  std::uint64_t next_mark() { return ++mark_counter_; }  // 64 bits: never wraps
 
   /// Sorted distinct neighbours of v.
-  void neighbours(std::uint32_t v, std::vector<std::uint32_t>& out) const {
+  void neighbours(std::uint32_t v, std::vector<std::uint32_t>& out) {
     out.clear();
-    for (const std::uint32_t f : incident_[v])
-      for (const std::uint32_t w : faces_[f])
-        if (w != v) out.push_back(w);
+    for_each_neighbour(v, [&](std::uint32_t w) { out.push_back(w); });
     std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
   }
 
   /// Link condition for the interior edge (u, v): its two faces' opposite vertices are the only common
@@ -245,27 +306,27 @@ class Collapser {
   /// locked (a border vertex may end in a single face).
   bool link_condition(std::uint32_t u, std::uint32_t v) {
     int shared = 0;
-    for (const std::uint32_t f : incident_[u])
+    for (const std::uint32_t f : faces_of(u))
       if (has(faces_[f], v)) {
         ++shared;
         for (const std::uint32_t w : faces_[f])
-          if (w != u && w != v && incident_[w].size() <= (locked_[w] ? 1u : 3u)) return false;
+          if (w != u && w != v && incident_.size(w) <= (locked_[w] ? 1u : 3u)) return false;
       }
     if (shared != 2) return false;
-    neighbours(u, ring_u_);
-    neighbours(v, ring_v_);
-    std::size_t common = 0;
-    for (auto i = ring_u_.begin(), j = ring_v_.begin(); i != ring_u_.end() && j != ring_v_.end();) {
-      if (*i < *j) ++i;
-      else if (*j < *i) ++j;
-      else ++common, ++i, ++j;
-    }
+    // Mark u's neighbours, then count v's distinct neighbours that carry the mark (a second mark dedupes).
+    for_each_neighbour(u, [](std::uint32_t) {});
+    const std::uint64_t of_u = mark_counter_;
+    int common = 0;
+    const std::uint64_t seen = next_mark();
+    for (const std::uint32_t f : faces_of(v))
+      for (const std::uint32_t w : faces_[f])
+        if (w != v && mark_[w] == of_u) mark_[w] = seen, ++common;
     return common == 2;
   }
 
   /// No face that survives the move of `moved` to p turns by more than the limit or becomes a sliver.
   bool faces_stay_sound(std::uint32_t moved, std::uint32_t other, const Vec3d& p) const {
-    for (const std::uint32_t f : incident_[moved]) {
+    for (const std::uint32_t f : faces_of(moved)) {
       const Face& t = faces_[f];
       if (has(t, other)) continue;
       Vec3d before[3], after[3];
@@ -283,28 +344,23 @@ class Collapser {
     return link_condition(u, v) && faces_stay_sound(u, v, p) && (p == positions_[v] || faces_stay_sound(v, u, p));
   }
 
-  void unlink(std::uint32_t w, std::uint32_t f) {
-    std::vector<std::uint32_t>& list = incident_[w];
-    const auto it = std::find(list.begin(), list.end(), f);
-    *it = list.back();
-    list.pop_back();
-  }
-
   /// u goes, v moves to p: u's two faces with v die, u's other faces switch to v.
   void collapse(std::uint32_t u, std::uint32_t v, const Vec3d& p) {
-    for (const std::uint32_t f : incident_[u]) {
+    // By index: pushing to v's list may move the pool under u's.
+    for (std::uint32_t i = 0; i < incident_.size(u); ++i) {
+      const std::uint32_t f = incident_.begin(u)[i];
       Face& t = faces_[f];
       if (has(t, v)) {
         for (const std::uint32_t w : t)
-          if (w != u) unlink(w, f);
+          if (w != u) incident_.erase(w, f);
         t = {kNone, kNone, kNone};
         --alive_faces_;
       } else {
         for (std::uint32_t& w : t) w = w == u ? v : w;
-        incident_[v].push_back(f);
+        incident_.push(v, f);
       }
     }
-    incident_[u] = {};
+    incident_.clear(u);
     parked_[u] = {};
     positions_[v] = p;
     quadrics_[v] = quadrics_[v] + quadrics_[u];
@@ -324,7 +380,7 @@ class Collapser {
 
   void unpark(std::uint32_t w) {
     for (const std::uint32_t x : parked_[w])
-      if (std::any_of(incident_[w].begin(), incident_[w].end(), [&](std::uint32_t f) { return has(faces_[f], x); }))
+      if (std::any_of(incident_.begin(w), incident_.end(w), [&](std::uint32_t f) { return has(faces_[f], x); }))
         push_edge(w, x, true);
     parked_[w].clear();
   }
@@ -350,12 +406,14 @@ class Collapser {
   std::vector<Vec3d> positions_;
   std::vector<Quadric> quadrics_;
   std::vector<Face> faces_;  ///< {kNone, kNone, kNone} once collapsed away
-  std::vector<std::vector<std::uint32_t>> incident_;  ///< vertex -> its live faces
+  Incidence incident_;  ///< vertex -> its live faces
+  std::vector<std::uint64_t> mark_;  ///< per-vertex scratch marks (for_each_neighbour)
+  std::uint64_t mark_counter_ = 0;
   std::vector<std::vector<std::uint32_t>> parked_;  ///< vertex -> other ends of its refused collapses
   std::vector<std::uint32_t> version_;  ///< bumped when a vertex moves or goes: older heap entries are stale
   std::vector<char> locked_;
   QuadHeap heap_;
-  std::vector<std::uint32_t> ring_u_, ring_v_;  ///< scratch
+  std::vector<std::uint32_t> ring_v_;  ///< scratch
   std::size_t alive_faces_;
   CollapseOptions options_;
   double cos_limit_ = 0;
