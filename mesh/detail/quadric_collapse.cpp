@@ -84,6 +84,7 @@ struct Candidate {
 class QuadHeap {
  public:
   bool empty() const { return a_.empty(); }
+  const Candidate& top() const { return a_[0]; }
   /// Appends without ordering; call heapify() before the next pop.
   void append(const Candidate& c) { a_.push_back(c); }
   void heapify() {
@@ -236,6 +237,7 @@ class Collapser {
         swept_size = heap_.size();
       }
       const Candidate c = heap_.pop();
+      if (!heap_.empty()) prefetch_vertex(heap_.top().removed()), prefetch_vertex(heap_.top().kept);
       const std::uint32_t removed = c.removed();
       if (stale(c)) continue;
       const Vec3d p = placement(removed, c.kept, verts_[removed].quadric + verts_[c.kept].quadric);
@@ -282,6 +284,11 @@ class Collapser {
     return verts_[kept].locked ? verts_[kept].position : optimal_position(q, verts_[removed].position, verts_[kept].position);
   }
 
+  /// Starts loading v's record (both cache lines) ahead of its use.
+  void prefetch_vertex(std::uint32_t v) const {
+    __builtin_prefetch(&verts_[v]);
+    __builtin_prefetch(reinterpret_cast<const char*>(&verts_[v]) + 64);
+  }
   static bool has(const Face& t, std::uint32_t v) { return t[0] == v || t[1] == v || t[2] == v; }
   FaceRange faces_of(std::uint32_t v) const { return {incident_.begin(v), incident_.end(v)}; }
 
@@ -369,6 +376,8 @@ class Collapser {
     ++version_[u];
     ++version_[v];
     neighbours(v, ring_v_);
+    // Each push reads a neighbour's record, a likely cache miss: start all of them at once.
+    for (const std::uint32_t w : ring_v_) prefetch_vertex(w);
     for (const std::uint32_t w : ring_v_) push_edge(v, w, true);
     // The faces around v and its neighbours changed: their refused collapses get another chance.
     parked_[v].clear();
