@@ -82,18 +82,20 @@ struct Candidate {
 /// Min-heap with 4 children per node: half the depth of a binary heap, siblings on adjacent cache lines (the
 /// heap was the hot spot: most pops are stale entries).
 class QuadHeap {
+  static constexpr std::size_t kArity = 4;
+
  public:
   bool empty() const { return a_.empty(); }
   const Candidate& top() const { return a_[0]; }
   /// Appends without ordering; call heapify() before the next pop.
   void append(const Candidate& c) { a_.push_back(c); }
   void heapify() {
-    for (std::size_t i = a_.size() / 4 + 1; i-- > 0;) sift_down(i);
+    for (std::size_t i = a_.size() / kArity + 1; i-- > 0;) sift_down(i);
   }
   void push(const Candidate& c) {
     std::size_t i = a_.size();
     a_.push_back(c);
-    while (i > 0 && a_[(i - 1) / 4].key > c.key) a_[i] = a_[(i - 1) / 4], i = (i - 1) / 4;
+    while (i > 0 && a_[(i - 1) / kArity].key > c.key) a_[i] = a_[(i - 1) / kArity], i = (i - 1) / kArity;
     a_[i] = c;
   }
   std::size_t size() const { return a_.size(); }
@@ -116,13 +118,13 @@ class QuadHeap {
     const Candidate c = a_[i];
     const std::size_t n = a_.size();
     for (;;) {
-      const std::size_t first = 4 * i + 1;
+      const std::size_t first = kArity * i + 1;
       if (first >= n) break;
       // The next level is a cache miss per step: fetch all four children's children while comparing.
-      for (std::size_t j = first; j < std::min(first + 4, n); ++j)
-        if (4 * j + 1 < n) __builtin_prefetch(&a_[4 * j + 1]);
+      for (std::size_t j = first; j < std::min(first + kArity, n); ++j)
+        if (kArity * j + 1 < n) __builtin_prefetch(&a_[kArity * j + 1]);
       std::size_t best = first;
-      for (std::size_t j = first + 1; j < std::min(first + 4, n); ++j)
+      for (std::size_t j = first + 1; j < std::min(first + kArity, n); ++j)
         if (a_[j].key < a_[best].key) best = j;
       if (a_[best].key >= c.key) break;
       a_[i] = a_[best];
@@ -371,6 +373,7 @@ class Collapser {
     }
     incident_.clear(u);
     parked_[u] = {};
+    verts_[u].parked = false;
     verts_[v].position = p;
     verts_[v].quadric = verts_[v].quadric + verts_[u].quadric;
     ++version_[u];
@@ -381,15 +384,19 @@ class Collapser {
     for (const std::uint32_t w : ring_v_) push_edge(v, w, true);
     // The faces around v and its neighbours changed: their refused collapses get another chance.
     parked_[v].clear();
+    verts_[v].parked = false;
     for (const std::uint32_t w : ring_v_) unpark(w);
   }
 
   void park(std::uint32_t w, std::uint32_t x) {
+    verts_[w].parked = true;
     std::vector<std::uint32_t>& list = parked_[w];
     if (std::find(list.begin(), list.end(), x) == list.end()) list.push_back(x);
   }
 
   void unpark(std::uint32_t w) {
+    if (!verts_[w].parked) return;  // the common case, answered from the record the pushes just loaded
+    verts_[w].parked = false;
     for (const std::uint32_t x : parked_[w])
       if (std::any_of(incident_.begin(w), incident_.end(w), [&](std::uint32_t f) { return has(faces_[f], x); }))
         push_edge(w, x, true);
@@ -420,6 +427,7 @@ class Collapser {
     Quadric quadric;
     Vec3d position;
     bool locked = false;
+    bool parked = false;  ///< parked_ of this vertex is not empty
   };
   std::vector<Vertex> verts_;
   /// Bumped when a vertex moves or goes: older heap entries are stale. Apart from verts_: every pop and every
