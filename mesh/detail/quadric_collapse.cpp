@@ -212,7 +212,7 @@ class Collapser {
     for (std::uint32_t f = 0; f < faces_.size(); ++f) {
       const Face& t = faces_[f];
       if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
-        for (const std::uint32_t v : t) verts_[v].locked = 1;
+        for (const std::uint32_t v : t) verts_[v].locked = true;
       const Vec3d a = verts_[t[0]].position, n2 = cross(verts_[t[1]].position - a, verts_[t[2]].position - a);
       const double len = length(n2);
       if (!(len > 0)) continue;
