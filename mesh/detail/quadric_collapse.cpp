@@ -82,17 +82,20 @@ struct Candidate {
 /// Min-heap with 4 children per node: half the depth of a binary heap, siblings on adjacent cache lines (the
 /// heap was the hot spot: most pops are stale entries).
 class QuadHeap {
+  static constexpr std::size_t kArity = 4;
+
  public:
   bool empty() const { return a_.empty(); }
+  const Candidate& top() const { return a_[0]; }
   /// Appends without ordering; call heapify() before the next pop.
   void append(const Candidate& c) { a_.push_back(c); }
   void heapify() {
-    for (std::size_t i = a_.size() / 4 + 1; i-- > 0;) sift_down(i);
+    for (std::size_t i = a_.size() / kArity + 1; i-- > 0;) sift_down(i);
   }
   void push(const Candidate& c) {
     std::size_t i = a_.size();
     a_.push_back(c);
-    while (i > 0 && a_[(i - 1) / 4].key > c.key) a_[i] = a_[(i - 1) / 4], i = (i - 1) / 4;
+    while (i > 0 && a_[(i - 1) / kArity].key > c.key) a_[i] = a_[(i - 1) / kArity], i = (i - 1) / kArity;
     a_[i] = c;
   }
   std::size_t size() const { return a_.size(); }
@@ -115,10 +118,13 @@ class QuadHeap {
     const Candidate c = a_[i];
     const std::size_t n = a_.size();
     for (;;) {
-      const std::size_t first = 4 * i + 1;
+      const std::size_t first = kArity * i + 1;
       if (first >= n) break;
+      // The next level is a cache miss per step: fetch all four children's children while comparing.
+      for (std::size_t j = first; j < std::min(first + kArity, n); ++j)
+        if (kArity * j + 1 < n) __builtin_prefetch(&a_[kArity * j + 1]);
       std::size_t best = first;
-      for (std::size_t j = first + 1; j < std::min(first + 4, n); ++j)
+      for (std::size_t j = first + 1; j < std::min(first + kArity, n); ++j)
         if (a_[j].key < a_[best].key) best = j;
       if (a_[best].key >= c.key) break;
       a_[i] = a_[best];
@@ -137,31 +143,81 @@ std::uint64_t heap_key(double cost, std::uint32_t removed) {
   return std::uint64_t(bits) << 32 | removed;
 }
 
+/// vertex -> its live faces, in one flat pool (no per-vertex allocation in the collapse loop): each vertex owns
+/// a slot of `cap` entries; a list that outgrows its slot moves to the end of the pool with twice the room
+/// (the old slot is abandoned: the pool stays within a small multiple of 3F).
+class Incidence {
+ public:
+  void init(const std::vector<Face>& faces, std::size_t vertices) {
+    slots_.assign(vertices, Slot{});
+    for (const Face& t : faces)
+      for (const std::uint32_t v : t) ++slots_[v].cap;
+    std::uint32_t offset = 0;
+    for (Slot& s : slots_) s.begin = offset, s.cap += 2, offset += s.cap;  // slack for the first merges
+    pool_.resize(offset);
+    for (std::uint32_t f = 0; f < faces.size(); ++f)
+      for (const std::uint32_t v : faces[f]) push(v, f);
+  }
+  const std::uint32_t* begin(std::uint32_t v) const { return pool_.data() + slots_[v].begin; }
+  const std::uint32_t* end(std::uint32_t v) const { return begin(v) + slots_[v].size; }
+  std::uint32_t size(std::uint32_t v) const { return slots_[v].size; }
+  void push(std::uint32_t v, std::uint32_t f) {
+    Slot& s = slots_[v];
+    if (s.size == s.cap) {
+      const std::uint32_t moved = std::uint32_t(pool_.size());
+      pool_.resize(pool_.size() + 2 * s.cap);
+      std::copy_n(pool_.data() + s.begin, s.size, pool_.data() + moved);
+      s.begin = moved, s.cap *= 2;
+    }
+    pool_[s.begin + s.size++] = f;
+  }
+  /// Removes f from v's list (order not kept). \pre f is in it.
+  void erase(std::uint32_t v, std::uint32_t f) {
+    Slot& s = slots_[v];
+    std::uint32_t* list = pool_.data() + s.begin;
+    *std::find(list, list + s.size, f) = list[s.size - 1];
+    --s.size;
+  }
+  void clear(std::uint32_t v) { slots_[v].size = 0; }
+
+ private:
+  struct Slot {
+    std::uint32_t begin = 0, size = 0, cap = 0;
+  };
+  std::vector<Slot> slots_;
+  std::vector<std::uint32_t> pool_;
+};
+
+/// A range-for view of one vertex's faces.
+struct FaceRange {
+  const std::uint32_t *b, *e;
+  const std::uint32_t* begin() const { return b; }
+  const std::uint32_t* end() const { return e; }
+};
+
 class Collapser {
  public:
   Collapser(const TriMesh& mesh, const CollapseOptions& options)
       : faces_(mesh.triangles), alive_faces_(faces_.size()), options_(options) {
     const std::size_t n = mesh.vertex_count();
-    positions_.reserve(n);
-    for (const Vec3f& p : mesh.positions) positions_.push_back(Vec3d(p));
-    quadrics_.resize(n);
-    incident_.resize(n);
-    parked_.resize(n);
+    verts_.resize(n);
     version_.assign(n, 0);
-    locked_.assign(n, 0);
+    for (std::size_t v = 0; v < n; ++v) verts_[v].position = Vec3d(mesh.positions[v]);
+    incident_.init(faces_, n);
+    mark_.assign(n, 0);
+    parked_.resize(n);
     const std::vector<VertexKind> kinds = classify_vertices(mesh);
     for (std::size_t v = 0; v < n; ++v)
-      locked_[v] = kinds[v] == VertexKind::Boundary || kinds[v] == VertexKind::NonManifold;
+      verts_[v].locked = kinds[v] == VertexKind::Boundary || kinds[v] == VertexKind::NonManifold;
     for (std::uint32_t f = 0; f < faces_.size(); ++f) {
       const Face& t = faces_[f];
       if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
-        for (const std::uint32_t v : t) locked_[v] = 1;
-      for (const std::uint32_t v : t) incident_[v].push_back(f);
-      const Vec3d a = positions_[t[0]], n2 = cross(positions_[t[1]] - a, positions_[t[2]] - a);
+        for (const std::uint32_t v : t) verts_[v].locked = true;
+      const Vec3d a = verts_[t[0]].position, n2 = cross(verts_[t[1]].position - a, verts_[t[2]].position - a);
       const double len = length(n2);
       if (!(len > 0)) continue;
       const Vec3d normal = n2 / len;
-      for (const std::uint32_t v : t) quadrics_[v].add_plane(normal, -dot(normal, a), 0.5 * len);
+      for (const std::uint32_t v : t) verts_[v].quadric.add_plane(normal, -dot(normal, a), 0.5 * len);
     }
     cos_limit_ = std::cos(options.max_normal_deviation_deg * M_PI / 180.0);
   }
@@ -183,9 +239,10 @@ class Collapser {
         swept_size = heap_.size();
       }
       const Candidate c = heap_.pop();
+      if (!heap_.empty()) prefetch_vertex(heap_.top().removed()), prefetch_vertex(heap_.top().kept);
       const std::uint32_t removed = c.removed();
       if (stale(c)) continue;
-      const Vec3d p = placement(removed, c.kept, quadrics_[removed] + quadrics_[c.kept]);
+      const Vec3d p = placement(removed, c.kept, verts_[removed].quadric + verts_[c.kept].quadric);
       if (!can_collapse(removed, c.kept, p)) {
         park(removed, c.kept);
         park(c.kept, removed);
@@ -194,7 +251,8 @@ class Collapser {
       collapse(removed, c.kept, p);
       ++result.collapses;
     }
-    result.locked_vertices = std::size_t(std::count(locked_.begin(), locked_.end(), 1));
+    result.locked_vertices =
+        std::size_t(std::count_if(verts_.begin(), verts_.end(), [](const Vertex& v) { return v.locked; }));
     result.mesh = compact();
     return result;
   }
@@ -212,9 +270,9 @@ class Collapser {
 
   /// The kept end is the locked one (a locked vertex neither moves nor goes), else the lower id.
   void push_edge(std::uint32_t a, std::uint32_t b, bool heapify = false) {
-    if (locked_[a] && locked_[b]) return;
-    const std::uint32_t kept = locked_[a] || (!locked_[b] && a < b) ? a : b, removed = kept == a ? b : a;
-    const Quadric q = quadrics_[a] + quadrics_[b];
+    if (verts_[a].locked && verts_[b].locked) return;
+    const std::uint32_t kept = verts_[a].locked || (!verts_[b].locked && a < b) ? a : b, removed = kept == a ? b : a;
+    const Quadric q = verts_[a].quadric + verts_[b].quadric;
     const double cost = q.error(placement(removed, kept, q));
     const double limit = options_.max_rms_error;
     if (limit > 0 && cost > limit * limit * q.area) return;
@@ -225,19 +283,33 @@ class Collapser {
 
   /// `q` = the summed quadric of both ends.
   Vec3d placement(std::uint32_t removed, std::uint32_t kept, const Quadric& q) const {
-    return locked_[kept] ? positions_[kept] : optimal_position(q, positions_[removed], positions_[kept]);
+    return verts_[kept].locked ? verts_[kept].position : optimal_position(q, verts_[removed].position, verts_[kept].position);
   }
 
+  /// Starts loading v's record (both cache lines) ahead of its use.
+  void prefetch_vertex(std::uint32_t v) const {
+    __builtin_prefetch(&verts_[v]);
+    __builtin_prefetch(reinterpret_cast<const char*>(&verts_[v]) + 64);
+  }
   static bool has(const Face& t, std::uint32_t v) { return t[0] == v || t[1] == v || t[2] == v; }
+  FaceRange faces_of(std::uint32_t v) const { return {incident_.begin(v), incident_.end(v)}; }
+
+  /// Calls visit(w) once for each distinct neighbour w of v, in no particular order. Each pass takes a fresh mark,
+  /// so no clearing is needed.
+  template <typename Visit>
+  void for_each_neighbour(std::uint32_t v, Visit visit) {
+    const std::uint64_t seen = next_mark();
+    for (const std::uint32_t f : faces_of(v))
+      for (const std::uint32_t w : faces_[f])
+        if (w != v && mark_[w] != seen) mark_[w] = seen, visit(w);
+  }
+  std::uint64_t next_mark() { return ++mark_counter_; }  // 64 bits: never wraps
 
   /// Sorted distinct neighbours of v.
-  void neighbours(std::uint32_t v, std::vector<std::uint32_t>& out) const {
+  void neighbours(std::uint32_t v, std::vector<std::uint32_t>& out) {
     out.clear();
-    for (const std::uint32_t f : incident_[v])
-      for (const std::uint32_t w : faces_[f])
-        if (w != v) out.push_back(w);
+    for_each_neighbour(v, [&](std::uint32_t w) { out.push_back(w); });
     std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
   }
 
   /// Link condition for the interior edge (u, v): its two faces' opposite vertices are the only common
@@ -245,31 +317,31 @@ class Collapser {
   /// locked (a border vertex may end in a single face).
   bool link_condition(std::uint32_t u, std::uint32_t v) {
     int shared = 0;
-    for (const std::uint32_t f : incident_[u])
+    for (const std::uint32_t f : faces_of(u))
       if (has(faces_[f], v)) {
         ++shared;
         for (const std::uint32_t w : faces_[f])
-          if (w != u && w != v && incident_[w].size() <= (locked_[w] ? 1u : 3u)) return false;
+          if (w != u && w != v && incident_.size(w) <= (verts_[w].locked ? 1u : 3u)) return false;
       }
     if (shared != 2) return false;
-    neighbours(u, ring_u_);
-    neighbours(v, ring_v_);
-    std::size_t common = 0;
-    for (auto i = ring_u_.begin(), j = ring_v_.begin(); i != ring_u_.end() && j != ring_v_.end();) {
-      if (*i < *j) ++i;
-      else if (*j < *i) ++j;
-      else ++common, ++i, ++j;
-    }
+    // Mark u's neighbours, then count v's distinct neighbours that carry the mark (a second mark dedupes).
+    for_each_neighbour(u, [](std::uint32_t) {});
+    const std::uint64_t of_u = mark_counter_;
+    int common = 0;
+    const std::uint64_t seen = next_mark();
+    for (const std::uint32_t f : faces_of(v))
+      for (const std::uint32_t w : faces_[f])
+        if (w != v && mark_[w] == of_u) mark_[w] = seen, ++common;
     return common == 2;
   }
 
   /// No face that survives the move of `moved` to p turns by more than the limit or becomes a sliver.
   bool faces_stay_sound(std::uint32_t moved, std::uint32_t other, const Vec3d& p) const {
-    for (const std::uint32_t f : incident_[moved]) {
+    for (const std::uint32_t f : faces_of(moved)) {
       const Face& t = faces_[f];
       if (has(t, other)) continue;
       Vec3d before[3], after[3];
-      for (int k = 0; k < 3; ++k) before[k] = after[k] = positions_[t[k]], after[k] = t[k] == moved ? p : before[k];
+      for (int k = 0; k < 3; ++k) before[k] = after[k] = verts_[t[k]].position, after[k] = t[k] == moved ? p : before[k];
       const Vec3d n0 = cross(before[1] - before[0], before[2] - before[0]);
       const Vec3d n1 = cross(after[1] - after[0], after[2] - after[0]);
       const double q1 = quality(after[0], after[1], after[2], n1);
@@ -280,65 +352,67 @@ class Collapser {
   }
 
   bool can_collapse(std::uint32_t u, std::uint32_t v, const Vec3d& p) {
-    return link_condition(u, v) && faces_stay_sound(u, v, p) && (p == positions_[v] || faces_stay_sound(v, u, p));
-  }
-
-  void unlink(std::uint32_t w, std::uint32_t f) {
-    std::vector<std::uint32_t>& list = incident_[w];
-    const auto it = std::find(list.begin(), list.end(), f);
-    *it = list.back();
-    list.pop_back();
+    return link_condition(u, v) && faces_stay_sound(u, v, p) && (p == verts_[v].position || faces_stay_sound(v, u, p));
   }
 
   /// u goes, v moves to p: u's two faces with v die, u's other faces switch to v.
   void collapse(std::uint32_t u, std::uint32_t v, const Vec3d& p) {
-    for (const std::uint32_t f : incident_[u]) {
+    // By index: pushing to v's list may move the pool under u's.
+    for (std::uint32_t i = 0; i < incident_.size(u); ++i) {
+      const std::uint32_t f = incident_.begin(u)[i];
       Face& t = faces_[f];
       if (has(t, v)) {
         for (const std::uint32_t w : t)
-          if (w != u) unlink(w, f);
+          if (w != u) incident_.erase(w, f);
         t = {kNone, kNone, kNone};
         --alive_faces_;
       } else {
         for (std::uint32_t& w : t) w = w == u ? v : w;
-        incident_[v].push_back(f);
+        incident_.push(v, f);
       }
     }
-    incident_[u] = {};
+    incident_.clear(u);
     parked_[u] = {};
-    positions_[v] = p;
-    quadrics_[v] = quadrics_[v] + quadrics_[u];
+    verts_[u].parked = false;
+    verts_[v].position = p;
+    verts_[v].quadric = verts_[v].quadric + verts_[u].quadric;
     ++version_[u];
     ++version_[v];
     neighbours(v, ring_v_);
+    // Each push reads a neighbour's record, a likely cache miss: start all of them at once.
+    for (const std::uint32_t w : ring_v_) prefetch_vertex(w);
     for (const std::uint32_t w : ring_v_) push_edge(v, w, true);
     // The faces around v and its neighbours changed: their refused collapses get another chance.
     parked_[v].clear();
+    verts_[v].parked = false;
     for (const std::uint32_t w : ring_v_) unpark(w);
   }
 
   void park(std::uint32_t w, std::uint32_t x) {
+    verts_[w].parked = true;
     std::vector<std::uint32_t>& list = parked_[w];
     if (std::find(list.begin(), list.end(), x) == list.end()) list.push_back(x);
   }
 
   void unpark(std::uint32_t w) {
+    if (!verts_[w].parked) return;  // the common case, answered from the record the pushes just loaded
+    verts_[w].parked = false;
     for (const std::uint32_t x : parked_[w])
-      if (std::any_of(incident_[w].begin(), incident_[w].end(), [&](std::uint32_t f) { return has(faces_[f], x); }))
+      if (std::any_of(incident_.begin(w), incident_.end(w), [&](std::uint32_t f) { return has(faces_[f], x); }))
         push_edge(w, x, true);
     parked_[w].clear();
   }
 
   TriMesh compact() const {
     TriMesh out;
-    std::vector<std::uint32_t> index(positions_.size(), kNone);
+    std::vector<std::uint32_t> index(verts_.size(), kNone);
     for (const Face& t : faces_) {
       if (t[0] == kNone) continue;
       Face o;
       for (int k = 0; k < 3; ++k) {
         if (index[t[k]] == kNone) {
           index[t[k]] = std::uint32_t(out.positions.size());
-          out.positions.push_back(Vec3f(positions_[t[k]]));
+          out.positions.push_back(Vec3f(verts_[t[k]].position));
         }
         o[k] = index[t[k]];
       }
@@ -347,15 +421,25 @@ class Collapser {
     return out;
   }
 
-  std::vector<Vec3d> positions_;
-  std::vector<Quadric> quadrics_;
+  /// What an edge cost reads about a vertex, in two cache lines (these reads are the main cache misses after
+  /// the heap's).
+  struct alignas(64) Vertex {
+    Quadric quadric;
+    Vec3d position;
+    bool locked = false;
+    bool parked = false;  ///< parked_ of this vertex is not empty
+  };
+  std::vector<Vertex> verts_;
+  /// Bumped when a vertex moves or goes: older heap entries are stale. Apart from verts_: every pop and every
+  /// heap sweep reads it, and a compact array stays in cache.
+  std::vector<std::uint32_t> version_;
   std::vector<Face> faces_;  ///< {kNone, kNone, kNone} once collapsed away
-  std::vector<std::vector<std::uint32_t>> incident_;  ///< vertex -> its live faces
+  Incidence incident_;  ///< vertex -> its live faces
+  std::vector<std::uint64_t> mark_;  ///< per-vertex scratch marks (for_each_neighbour)
+  std::uint64_t mark_counter_ = 0;
   std::vector<std::vector<std::uint32_t>> parked_;  ///< vertex -> other ends of its refused collapses
-  std::vector<std::uint32_t> version_;  ///< bumped when a vertex moves or goes: older heap entries are stale
-  std::vector<char> locked_;
   QuadHeap heap_;
-  std::vector<std::uint32_t> ring_u_, ring_v_;  ///< scratch
+  std::vector<std::uint32_t> ring_v_;  ///< scratch
   std::size_t alive_faces_;
   CollapseOptions options_;
   double cos_limit_ = 0;
