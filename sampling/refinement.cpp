@@ -1,5 +1,8 @@
 #include "sampling/refinement.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -25,13 +28,32 @@ int bucket_of(float priority) {
   return std::min(kBuckets - 1, std::max(0, b + 2 * kBucketsPerOctave));  // priorities up to 4 get bucket >= 0
 }
 
+// Ascending order of `keys`: LSD radix sort, 11 bits a pass over the bits in use, for the large rounds (the
+// same order std::sort gives: it is a sort of plain integers).
+void sort_keys(std::vector<std::uint64_t>& keys) {
+  if (keys.size() < 1024) {
+    std::sort(keys.begin(), keys.end());
+    return;
+  }
+  std::uint64_t used = 0;
+  for (std::uint64_t k : keys) used |= k;
+  std::vector<std::uint64_t> tmp(keys.size());
+  for (int shift = 0; shift < 64 && (used >> shift) != 0; shift += 11) {
+    std::array<std::size_t, 2049> start{};
+    for (std::uint64_t k : keys) ++start[((k >> shift) & 2047u) + 1];
+    for (std::size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+    for (std::uint64_t k : keys) tmp[start[(k >> shift) & 2047u]++] = k;
+    keys.swap(tmp);
+  }
+}
+
 // Sorts [first, last) by key(pixel), each key computed once (the keys hash, so a comparator would rehash).
 template <typename It, typename Key>
 void sort_by_key(It first, It last, const Key& key) {
   std::vector<std::uint64_t> keyed;
   keyed.reserve(std::size_t(last - first));
   for (It it = first; it != last; ++it) keyed.push_back(key(*it));
-  std::sort(keyed.begin(), keyed.end());
+  sort_keys(keyed);
   for (std::uint64_t k : keyed) *first++ = std::uint32_t(k & 0xFFFFFFFFu);
 }
 
@@ -88,6 +110,29 @@ std::array<std::array<int, 2>, 4> parent_offsets(int level, int spacing) {
   return {{{-d, 0}, {d, 0}, {0, -d}, {0, d}}};
 }
 
+// A candidate pixel and the priority its parents give it now.
+struct Candidate {
+  std::uint32_t pixel;
+  float priority;
+};
+
+// Runs chunk(first, last, out) over [0, n) in fixed chunks in parallel and concatenates the outputs in chunk
+// order, so the result does not depend on the thread count.
+template <typename Chunk>
+std::vector<Candidate> gather(std::size_t n, std::size_t chunk_size, const Chunk& chunk) {
+  const std::size_t chunks = (n + chunk_size - 1) / chunk_size;
+  std::vector<std::vector<Candidate>> parts(chunks);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t c = r.begin(); c < r.end(); ++c) chunk(c * chunk_size, std::min(n, (c + 1) * chunk_size), parts[c]);
+  });
+  std::vector<Candidate> out;
+  for (const std::vector<Candidate>& part : parts) out.insert(out.end(), part.begin(), part.end());
+  return out;
+}
+
+// Offers are evaluated in parallel and fed to the queue serially. This is exact: between two rounds no offer
+// changes what another offer reads (the traced set and the samples are fixed), so a candidate offered twice in a
+// round gets the same priority twice, and the queue sorts what a bucket received between two serves by hash.
 class Refiner {
  public:
   Refiner(const ImageF& importance, const FractalPattern& pattern, const RefinementOptions& options,
@@ -95,42 +140,41 @@ class Refiner {
       : imp_(importance), pattern_(pattern), options_(options), image_(image), traced_(traced),
         taken_(importance.width, importance.height, 0), offered_(importance.width, importance.height, 0.0f),
         percept_(importance.width, importance.height, std::array<std::uint8_t, 4>{}),
-        queue_(seed) {}
+        queue_(seed) {
+    for (int l = 0; l < int(level_share_.size()); ++l) level_share_[l] = std::ldexp(1.0f, -l);
+  }
 
   bool known(int x, int y) const { return imp_(x, y) < 0 || traced_(x, y); }
 
   // Candidates no traced parent will offer: every in-image parent is background.
   void offer_orphans() {
-    for (int y = 0; y < imp_.height; ++y)
-      for (int x = 0; x < imp_.width; ++x) {
-        const int level = pattern_.level(x, y);
-        if (level == 0 || imp_(x, y) < 0) continue;
-        bool orphan = true;
-        for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
-          const int px = x + o[0], py = y + o[1];
-          orphan = orphan && (px < 0 || py < 0 || px >= imp_.width || py >= imp_.height || imp_(px, py) < 0);
+    push(gather(std::size_t(imp_.height), 16, [this](std::size_t y0, std::size_t y1, std::vector<Candidate>& out) {
+      for (int y = int(y0); y < int(y1); ++y)
+        for (int x = 0; x < imp_.width; ++x) {
+          const int level = pattern_.level(x, y);
+          if (level == 0 || imp_(x, y) < 0) continue;
+          bool orphan = true;
+          for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
+            const int px = x + o[0], py = y + o[1];
+            orphan = orphan && (px < 0 || py < 0 || px >= imp_.width || py >= imp_.height || imp_(px, py) < 0);
+          }
+          if (orphan) evaluate(x, y, out);
         }
-        if (orphan) offer(x, y);
-      }
+    }));
   }
 
-  // A traced pixel's values as the contrast sees them: RGB through a square root (close to sRGB), alpha,
-  // quantised to 1/255 (finer than any floor worth setting).
-  void record(std::uint32_t pixel) {
-    const Rgba& c = image_.pixels[pixel];
-    auto code = [](float v) { return std::uint8_t(std::lround(255.0f * std::min(1.0f, std::max(0.0f, v)))); };
-    percept_.pixels[pixel] = {code(std::sqrt(std::max(0.0f, c.r))), code(std::sqrt(std::max(0.0f, c.g))),
-                              code(std::sqrt(std::max(0.0f, c.b))), code(c.a)};
-  }
-
-  // After `pixel` was traced: the children it may have completed, at every finer level.
-  void offer_children(std::uint32_t pixel) {
-    const int w = imp_.width, qx = int(pixel % std::uint32_t(w)), qy = int(pixel / std::uint32_t(w));
-    for (int level = pattern_.level(qx, qy) + 1; level < pattern_.num_levels; ++level)
-      for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
-        const int x = qx - o[0], y = qy - o[1];
-        if (x >= 0 && y >= 0 && x < w && y < imp_.height && pattern_.level(x, y) == level) offer(x, y);
-      }
+  // `pixels` were traced: marks and record()s them, then offers the children they may have completed.
+  void add_traced(const std::vector<std::uint32_t>& pixels) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pixels.size(), 1024),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t i = r.begin(); i < r.end(); ++i) {
+                          traced_.pixels[pixels[i]] = 1;
+                          record(pixels[i]);
+                        }
+                      });
+    push(gather(pixels.size(), 1024, [&](std::size_t first, std::size_t last, std::vector<Candidate>& out) {
+      for (std::size_t i = first; i < last; ++i) children(pixels[i], out);
+    }));
   }
 
   // The best `count` waiting candidates; stale entries (a pixel re-offered at a higher priority, or taken) skipped.
@@ -148,36 +192,64 @@ class Refiner {
   std::size_t waiting() const { return queue_.size(); }
 
  private:
-  void offer(int x, int y) {
+  // A traced pixel's values as the contrast sees them: RGB through a square root (close to sRGB), alpha,
+  // quantised to 1/255 (finer than any floor worth setting).
+  void record(std::uint32_t pixel) {
+    const Rgba& c = image_.pixels[pixel];
+    auto code = [](float v) { return std::uint8_t(std::lround(255.0f * std::min(1.0f, std::max(0.0f, v)))); };
+    percept_.pixels[pixel] = {code(std::sqrt(std::max(0.0f, c.r))), code(std::sqrt(std::max(0.0f, c.g))),
+                              code(std::sqrt(std::max(0.0f, c.b))), code(c.a)};
+  }
+
+  // After `pixel` was traced: the children it may have completed, at every finer level.
+  void children(std::uint32_t pixel, std::vector<Candidate>& out) const {
+    const int w = imp_.width, qx = int(pixel % std::uint32_t(w)), qy = int(pixel / std::uint32_t(w));
+    for (int level = pattern_.level(qx, qy) + 1; level < pattern_.num_levels; ++level)
+      for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
+        const int x = qx - o[0], y = qy - o[1];
+        if (x >= 0 && y >= 0 && x < w && y < imp_.height && pattern_.level(x, y) == level) evaluate(x, y, out);
+      }
+  }
+
+  // Appends (x, y) with its priority unless it is known, taken, waits for a corner, or would not be pushed.
+  void evaluate(int x, int y, std::vector<Candidate>& out) const {
     if (known(x, y) || taken_(x, y)) return;
-    const int level = pattern_.level(x, y), lattice = 2 * parent_offset(level, pattern_.base_spacing);
-    std::array<float, 4> lo{INFINITY, INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    const int level = pattern_.level(x, y), lattice_mask = 2 * parent_offset(level, pattern_.base_spacing) - 1;
+    // Per channel in integer 1/255 steps; no known parent leaves hi < lo, contrast 0.
+    std::array<int, 4> lo{255, 255, 255, 255}, hi{0, 0, 0, 0};
     for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
       const int px = x + o[0], py = y + o[1];
       if (px < 0 || py < 0 || px >= imp_.width || py >= imp_.height) continue;
       // Required: the corners of the square cell being split (for an edge midpoint, the edge's two ends).
       // The squares' centres beside an edge midpoint only add contrast: requiring them would let a flat
       // neighbour cell block the refinement of an edge cell.
-      const bool corner = px % lattice == 0 && py % lattice == 0;
+      const bool corner = (px & lattice_mask) == 0 && (py & lattice_mask) == 0;
       if (!known(px, py)) {
         if (corner) return;  // offered again when this corner is traced
         continue;
       }
       const std::array<std::uint8_t, 4>& c = percept_(px, py);
-      const std::array<float, 4> v{float(c[0]), float(c[1]), float(c[2]), float(c[3])};
       for (int k = 0; k < 4; ++k) {
-        lo[k] = std::min(lo[k], v[k]);
-        hi[k] = std::max(hi[k], v[k]);
+        lo[k] = std::min(lo[k], int(c[k]));
+        hi[k] = std::max(hi[k], int(c[k]));
       }
     }
-    float contrast = 0;
-    for (int k = 0; k < 4; ++k) contrast = std::max(contrast, (hi[k] - lo[k]) * (1.0f / 255.0f));
-    const auto pixel = std::uint32_t(y) * std::uint32_t(imp_.width) + std::uint32_t(x);
-    const float priority = (contrast + options_.floor + options_.line_weight * imp_(x, y)) * std::ldexp(1.0f, -level);
-    // Offered again when another parent was traced: only a clearly higher priority is worth a second entry.
-    if (priority <= 1.05f * offered_(x, y)) return;
-    queue_.push(priority, pixel);
-    offered_(x, y) = priority;
+    int spread = 0;
+    for (int k = 0; k < 4; ++k) spread = std::max(spread, hi[k] - lo[k]);
+    const float contrast = float(spread) * (1.0f / 255.0f);
+    const float priority = (contrast + options_.floor + options_.line_weight * imp_(x, y)) * level_share_[level];
+    if (priority <= 1.05f * offered_(x, y)) return;  // see push()
+    out.push_back({std::uint32_t(y) * std::uint32_t(imp_.width) + std::uint32_t(x), priority});
+  }
+
+  void push(const std::vector<Candidate>& candidates) {
+    for (const Candidate& c : candidates) {
+      // Offered again when another parent was traced: only a clearly higher priority is worth a second entry.
+      float& offered = offered_.pixels[c.pixel];
+      if (c.priority <= 1.05f * offered) continue;
+      queue_.push(c.priority, c.pixel);
+      offered = c.priority;
+    }
   }
 
   const ImageF& imp_;
@@ -190,6 +262,7 @@ class Refiner {
   /// record()ed values of traced pixels in 1/255 steps (4 bytes a pixel); 0 on background, like its image.
   Image<std::array<std::uint8_t, 4>> percept_;
   BucketQueue queue_;
+  std::array<float, 16> level_share_;  ///< 2^-level, the share of the frame one ray of a level covers
 };
 
 // A round in 16x16 tiles, tile rows top to bottom: the caster traces each group of kRayGroup rays together,
@@ -243,14 +316,12 @@ RefinementResult trace_refined(const ImageF& importance, const FractalPattern& p
   const double level0_ms = std::max(1e-3, clock() - level0_start);
   RefinementResult result;
   result.level0 = result.rays = level0.size();
-  for (std::uint32_t p : level0) traced.pixels[p] = 1;
   result.level0_overran = stop.now && (*stop.now)() > stop.deadline_ms;
   double rays_per_ms = double(level0.size()) / level0_ms;
 
   Refiner refiner(importance, pattern, options, seed, image, traced);
-  for (std::uint32_t p : level0) refiner.record(p);
+  refiner.add_traced(level0);  // marks level 0 traced before the orphans are looked for
   refiner.offer_orphans();
-  for (std::uint32_t p : level0) refiner.offer_children(p);
   while (refiner.waiting() > 0) {
     // At most a quarter of the waiting candidates per round, so every round is a choice among them and an
     // edge can be followed down several levels (one per round) before the budget is spent on breadth.
@@ -269,11 +340,7 @@ RefinementResult trace_refined(const ImageF& importance, const FractalPattern& p
       in_tile_order(batch, w);
       trace_all(batch, trace, image);
     }
-    for (std::uint32_t p : batch) {
-      traced.pixels[p] = 1;
-      refiner.record(p);
-    }
-    for (std::uint32_t p : batch) refiner.offer_children(p);
+    refiner.add_traced(batch);
     result.rays += batch.size();
     if (batch.size() < popped) break;  // the deadline cut the round
   }
