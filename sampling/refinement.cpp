@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/parallel.h"
 #include "core/timer.h"
 #include "sampling/ray_order.h"
 
@@ -110,6 +111,16 @@ std::array<std::array<int, 2>, 4> parent_offsets(int level, int spacing) {
   return {{{-d, 0}, {d, 0}, {0, -d}, {0, d}}};
 }
 
+// What an offer reads and writes of a pixel whose parents are known, in one 16-byte record: offers touch
+// scattered pixels, and separate images would cost a cache miss each.
+struct alignas(16) Cell {
+  /// record()ed values of a traced pixel in 1/255 steps; 0 on background, like its image.
+  std::array<std::uint8_t, 4> percept{};
+  std::uint32_t unused = 0;
+  float importance = 0;    ///< p_imp
+  float offered = 0;       ///< highest priority offered so far (0 = never)
+};
+
 // A candidate pixel and the priority its parents give it now.
 struct Candidate {
   std::uint32_t pixel;
@@ -138,13 +149,17 @@ class Refiner {
   Refiner(const ImageF& importance, const FractalPattern& pattern, const RefinementOptions& options,
           std::uint64_t seed, ImageRGBA& image, ImageMask& traced)
       : imp_(importance), pattern_(pattern), options_(options), image_(image), traced_(traced),
-        taken_(importance.width, importance.height, 0), offered_(importance.width, importance.height, 0.0f),
-        percept_(importance.width, importance.height, std::array<std::uint8_t, 4>{}),
+        cells_(importance.width, importance.height), state_(importance.width, importance.height, 0),
         queue_(seed) {
+    parallel_rows(imp_.height, [this](int y) {
+      for (int x = 0; x < imp_.width; ++x) {
+        cells_(x, y).importance = imp_(x, y);
+        state_(x, y) = imp_(x, y) < 0 || traced_(x, y) ? kKnown : 0;
+      }
+    });
     for (int l = 0; l < int(level_share_.size()); ++l) level_share_[l] = std::ldexp(1.0f, -l);
   }
 
-  bool known(int x, int y) const { return imp_(x, y) < 0 || traced_(x, y); }
 
   // Candidates no traced parent will offer: every in-image parent is background.
   void offer_orphans() {
@@ -158,7 +173,7 @@ class Refiner {
             const int px = x + o[0], py = y + o[1];
             orphan = orphan && (px < 0 || py < 0 || px >= imp_.width || py >= imp_.height || imp_(px, py) < 0);
           }
-          if (orphan) evaluate(x, y, out);
+          if (orphan) evaluate(x, y, level, out);
         }
     }));
   }
@@ -169,6 +184,7 @@ class Refiner {
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         for (std::size_t i = r.begin(); i < r.end(); ++i) {
                           traced_.pixels[pixels[i]] = 1;
+                          state_.pixels[pixels[i]] |= kKnown;
                           record(pixels[i]);
                         }
                       });
@@ -182,8 +198,8 @@ class Refiner {
     std::vector<std::uint32_t> batch;
     while (batch.size() < count && queue_.size() > 0)
       for (std::uint32_t p : queue_.pop(count - batch.size()))
-        if (!taken_.pixels[p]) {
-          taken_.pixels[p] = 1;
+        if (!(state_.pixels[p] & kTaken)) {
+          state_.pixels[p] |= kTaken;
           batch.push_back(p);
         }
     return batch;
@@ -197,7 +213,7 @@ class Refiner {
   void record(std::uint32_t pixel) {
     const Rgba& c = image_.pixels[pixel];
     auto code = [](float v) { return std::uint8_t(std::lround(255.0f * std::min(1.0f, std::max(0.0f, v)))); };
-    percept_.pixels[pixel] = {code(std::sqrt(std::max(0.0f, c.r))), code(std::sqrt(std::max(0.0f, c.g))),
+    cells_.pixels[pixel].percept = {code(std::sqrt(std::max(0.0f, c.r))), code(std::sqrt(std::max(0.0f, c.g))),
                               code(std::sqrt(std::max(0.0f, c.b))), code(c.a)};
   }
 
@@ -207,28 +223,34 @@ class Refiner {
     for (int level = pattern_.level(qx, qy) + 1; level < pattern_.num_levels; ++level)
       for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
         const int x = qx - o[0], y = qy - o[1];
-        if (x >= 0 && y >= 0 && x < w && y < imp_.height && pattern_.level(x, y) == level) evaluate(x, y, out);
+        if (x >= 0 && y >= 0 && x < w && y < imp_.height && fractal_level(x, y, pattern_.base_spacing) == level)
+          evaluate(x, y, level, out);
       }
   }
 
-  // Appends (x, y) with its priority unless it is known, taken, waits for a corner, or would not be pushed.
-  void evaluate(int x, int y, std::vector<Candidate>& out) const {
-    if (known(x, y) || taken_(x, y)) return;
-    const int level = pattern_.level(x, y), lattice_mask = 2 * parent_offset(level, pattern_.base_spacing) - 1;
-    // Per channel in integer 1/255 steps; no known parent leaves hi < lo, contrast 0.
-    std::array<int, 4> lo{255, 255, 255, 255}, hi{0, 0, 0, 0};
+  // Appends (x, y) of `level` with its priority unless it is known, taken, waits for a corner, or would not
+  // be pushed. Most children asked about wait for a corner: that is decided on the small state_ mask alone.
+  void evaluate(int x, int y, int level, std::vector<Candidate>& out) const {
+    if (state_(x, y) != 0) return;
+    const int lattice_mask = 2 * parent_offset(level, pattern_.base_spacing) - 1;
+    std::array<int, 4> known{};  // the first n: pixel indices of the in-image known parents
+    int n = 0;
     for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
       const int px = x + o[0], py = y + o[1];
       if (px < 0 || py < 0 || px >= imp_.width || py >= imp_.height) continue;
       // Required: the corners of the square cell being split (for an edge midpoint, the edge's two ends).
       // The squares' centres beside an edge midpoint only add contrast: requiring them would let a flat
       // neighbour cell block the refinement of an edge cell.
-      const bool corner = (px & lattice_mask) == 0 && (py & lattice_mask) == 0;
-      if (!known(px, py)) {
-        if (corner) return;  // offered again when this corner is traced
+      if (!(state_(px, py) & kKnown)) {
+        if ((px & lattice_mask) == 0 && (py & lattice_mask) == 0) return;  // offered again when it is traced
         continue;
       }
-      const std::array<std::uint8_t, 4>& c = percept_(px, py);
+      known[n++] = py * imp_.width + px;
+    }
+    // Per channel in integer 1/255 steps; no known parent leaves hi < lo, contrast 0.
+    std::array<int, 4> lo{255, 255, 255, 255}, hi{0, 0, 0, 0};
+    for (int i = 0; i < n; ++i) {
+      const std::array<std::uint8_t, 4>& c = cells_.pixels[std::size_t(known[i])].percept;
       for (int k = 0; k < 4; ++k) {
         lo[k] = std::min(lo[k], int(c[k]));
         hi[k] = std::max(hi[k], int(c[k]));
@@ -237,15 +259,16 @@ class Refiner {
     int spread = 0;
     for (int k = 0; k < 4; ++k) spread = std::max(spread, hi[k] - lo[k]);
     const float contrast = float(spread) * (1.0f / 255.0f);
-    const float priority = (contrast + options_.floor + options_.line_weight * imp_(x, y)) * level_share_[level];
-    if (priority <= 1.05f * offered_(x, y)) return;  // see push()
+    const Cell& cell = cells_(x, y);
+    const float priority = (contrast + options_.floor + options_.line_weight * cell.importance) * level_share_[level];
+    if (priority <= 1.05f * cell.offered) return;  // see push()
     out.push_back({std::uint32_t(y) * std::uint32_t(imp_.width) + std::uint32_t(x), priority});
   }
 
   void push(const std::vector<Candidate>& candidates) {
     for (const Candidate& c : candidates) {
       // Offered again when another parent was traced: only a clearly higher priority is worth a second entry.
-      float& offered = offered_.pixels[c.pixel];
+      float& offered = cells_.pixels[c.pixel].offered;
       if (c.priority <= 1.05f * offered) continue;
       queue_.push(c.priority, c.pixel);
       offered = c.priority;
@@ -257,10 +280,9 @@ class Refiner {
   const RefinementOptions& options_;
   ImageRGBA& image_;
   ImageMask& traced_;
-  ImageMask taken_;   ///< popped for tracing
-  ImageF offered_;    ///< highest priority offered so far (0 = never)
-  /// record()ed values of traced pixels in 1/255 steps (4 bytes a pixel); 0 on background, like its image.
-  Image<std::array<std::uint8_t, 4>> percept_;
+  Image<Cell> cells_;
+  static constexpr std::uint8_t kKnown = 1, kTaken = 2;
+  ImageMask state_;  ///< kKnown: background or traced; kTaken: popped for tracing
   BucketQueue queue_;
   std::array<float, 16> level_share_;  ///< 2^-level, the share of the frame one ray of a level covers
 };
