@@ -18,11 +18,6 @@ int log2_exact(int v) {
 }
 }  // namespace
 
-int parent_offset(int level, int base_spacing) {
-  RAYSIFT_DCHECK(level >= 1);
-  return base_spacing >> ((level + 1) / 2);
-}
-
 float pattern_priority(int level, int num_levels) { return 1.0f - float(level) / float(num_levels); }
 
 FractalPattern make_fractal_pattern(int width, int height, int base_spacing) {

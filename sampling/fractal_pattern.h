@@ -38,6 +38,7 @@ float pattern_priority(int level, int num_levels);
 
 /// Half-distance h to the four parents of a pixel at `level` >= 1: odd levels (square centres) have
 /// parents at (x±h, y±h), even levels (diamond centres) at (x±h, y) and (x, y±h).
-int parent_offset(int level, int base_spacing);
+/// \pre level >= 1. Inline: the refinement asks it for every candidate.
+inline int parent_offset(int level, int base_spacing) { return base_spacing >> ((level + 1) / 2); }
 
 }  // namespace raysift::sampling

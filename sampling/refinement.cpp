@@ -121,6 +121,15 @@ struct alignas(16) Cell {
   float offered = 0;       ///< highest priority offered so far (0 = never)
 };
 
+// This thread's w x h image of P, contents unspecified: the refinement's 22 MB of state (at 1440x900) is
+// reused from frame to frame, as a fresh allocation costs a page fault every 4 KB.
+template <typename P>
+Image<P>& frame_buffer(int w, int h) {
+  thread_local Image<P> buffer;
+  if (buffer.width != w || buffer.height != h) buffer = Image<P>(w, h);
+  return buffer;
+}
+
 // A candidate pixel and the priority its parents give it now.
 struct Candidate {
   std::uint32_t pixel;
@@ -149,11 +158,13 @@ class Refiner {
   Refiner(const ImageF& importance, const FractalPattern& pattern, const RefinementOptions& options,
           std::uint64_t seed, ImageRGBA& image, ImageMask& traced)
       : imp_(importance), pattern_(pattern), options_(options), image_(image), traced_(traced),
-        cells_(importance.width, importance.height), state_(importance.width, importance.height, 0),
-        queue_(seed) {
+        cells_(frame_buffer<Cell>(importance.width, importance.height)),
+        state_(frame_buffer<std::uint8_t>(importance.width, importance.height)), queue_(seed) {
     parallel_rows(imp_.height, [this](int y) {
       for (int x = 0; x < imp_.width; ++x) {
-        cells_(x, y).importance = imp_(x, y);
+        Cell cell;
+        cell.importance = imp_(x, y);
+        cells_(x, y) = cell;
         state_(x, y) = imp_(x, y) < 0 || traced_(x, y) ? kKnown : 0;
       }
     });
@@ -220,7 +231,7 @@ class Refiner {
   // After `pixel` was traced: the children it may have completed, at every finer level.
   void children(std::uint32_t pixel, std::vector<Candidate>& out) const {
     const int w = imp_.width, qx = int(pixel % std::uint32_t(w)), qy = int(pixel / std::uint32_t(w));
-    for (int level = pattern_.level(qx, qy) + 1; level < pattern_.num_levels; ++level)
+    for (int level = fractal_level(qx, qy, pattern_.base_spacing) + 1; level < pattern_.num_levels; ++level)
       for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
         const int x = qx - o[0], y = qy - o[1];
         if (x >= 0 && y >= 0 && x < w && y < imp_.height && fractal_level(x, y, pattern_.base_spacing) == level)
@@ -280,9 +291,9 @@ class Refiner {
   const RefinementOptions& options_;
   ImageRGBA& image_;
   ImageMask& traced_;
-  Image<Cell> cells_;
+  Image<Cell>& cells_;
   static constexpr std::uint8_t kKnown = 1, kTaken = 2;
-  ImageMask state_;  ///< kKnown: background or traced; kTaken: popped for tracing
+  ImageMask& state_;  ///< kKnown: background or traced; kTaken: popped for tracing
   BucketQueue queue_;
   std::array<float, 16> level_share_;  ///< 2^-level, the share of the frame one ray of a level covers
 };
