@@ -130,6 +130,14 @@ Image<P>& frame_buffer(int w, int h) {
   return buffer;
 }
 
+// A candidate whose corners are known, with its known parents.
+struct Ready {
+  std::uint32_t pixel;
+  int level;
+  int known;  ///< parents[0, known)
+  std::array<std::uint32_t, 4> parents;
+};
+
 // A candidate pixel and the priority its parents give it now.
 struct Candidate {
   std::uint32_t pixel;
@@ -175,6 +183,7 @@ class Refiner {
   // Candidates no traced parent will offer: every in-image parent is background.
   void offer_orphans() {
     push(gather(std::size_t(imp_.height), 16, [this](std::size_t y0, std::size_t y1, std::vector<Candidate>& out) {
+      std::vector<Ready> ready;
       for (int y = int(y0); y < int(y1); ++y)
         for (int x = 0; x < imp_.width; ++x) {
           const int level = pattern_.level(x, y);
@@ -184,8 +193,9 @@ class Refiner {
             const int px = x + o[0], py = y + o[1];
             orphan = orphan && (px < 0 || py < 0 || px >= imp_.width || py >= imp_.height || imp_(px, py) < 0);
           }
-          if (orphan) evaluate(x, y, level, out);
+          if (orphan) list_ready(x, y, level, ready);
         }
+      for (const Ready& r : ready) evaluate(r, out);
     }));
   }
 
@@ -200,7 +210,8 @@ class Refiner {
                         }
                       });
     push(gather(pixels.size(), 1024, [&](std::size_t first, std::size_t last, std::vector<Candidate>& out) {
-      for (std::size_t i = first; i < last; ++i) children(pixels[i], out);
+      evaluate_all(last - first, [&](std::size_t i, std::vector<Ready>& ready) { children(pixels[first + i], ready); },
+                   out);
     }));
   }
 
@@ -229,23 +240,23 @@ class Refiner {
   }
 
   // After `pixel` was traced: the children it may have completed, at every finer level.
-  void children(std::uint32_t pixel, std::vector<Candidate>& out) const {
+  void children(std::uint32_t pixel, std::vector<Ready>& ready) const {
     const int w = imp_.width, qx = int(pixel % std::uint32_t(w)), qy = int(pixel / std::uint32_t(w));
     for (int level = fractal_level(qx, qy, pattern_.base_spacing) + 1; level < pattern_.num_levels; ++level)
       for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
         const int x = qx - o[0], y = qy - o[1];
         if (x >= 0 && y >= 0 && x < w && y < imp_.height && fractal_level(x, y, pattern_.base_spacing) == level)
-          evaluate(x, y, level, out);
+          list_ready(x, y, level, ready);
       }
   }
 
-  // Appends (x, y) of `level` with its priority unless it is known, taken, waits for a corner, or would not
-  // be pushed. Most children asked about wait for a corner: that is decided on the small state_ mask alone.
-  void evaluate(int x, int y, int level, std::vector<Candidate>& out) const {
+  // Appends (x, y) of `level` to `ready` unless it is known, taken or waits for a corner, decided on the small
+  // state_ mask alone (most children asked about wait for a corner), and prefetches the cells its priority
+  // reads: these are scattered, and a chunk's priorities are computed after all its children are listed.
+  void list_ready(int x, int y, int level, std::vector<Ready>& ready) const {
     if (state_(x, y) != 0) return;
     const int lattice_mask = 2 * parent_offset(level, pattern_.base_spacing) - 1;
-    std::array<int, 4> known{};  // the first n: pixel indices of the in-image known parents
-    int n = 0;
+    Ready r{std::uint32_t(y) * std::uint32_t(imp_.width) + std::uint32_t(x), level, 0, {}};
     for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
       const int px = x + o[0], py = y + o[1];
       if (px < 0 || py < 0 || px >= imp_.width || py >= imp_.height) continue;
@@ -256,12 +267,19 @@ class Refiner {
         if ((px & lattice_mask) == 0 && (py & lattice_mask) == 0) return;  // offered again when it is traced
         continue;
       }
-      known[n++] = py * imp_.width + px;
+      r.parents[r.known++] = std::uint32_t(py) * std::uint32_t(imp_.width) + std::uint32_t(px);
     }
+    for (int i = 0; i < r.known; ++i) __builtin_prefetch(&cells_.pixels[r.parents[i]]);
+    __builtin_prefetch(&cells_.pixels[r.pixel]);
+    ready.push_back(r);
+  }
+
+  // Appends `r` with its priority unless it would not be pushed.
+  void evaluate(const Ready& r, std::vector<Candidate>& out) const {
     // Per channel in integer 1/255 steps; no known parent leaves hi < lo, contrast 0.
     std::array<int, 4> lo{255, 255, 255, 255}, hi{0, 0, 0, 0};
-    for (int i = 0; i < n; ++i) {
-      const std::array<std::uint8_t, 4>& c = cells_.pixels[std::size_t(known[i])].percept;
+    for (int i = 0; i < r.known; ++i) {
+      const std::array<std::uint8_t, 4>& c = cells_.pixels[r.parents[i]].percept;
       for (int k = 0; k < 4; ++k) {
         lo[k] = std::min(lo[k], int(c[k]));
         hi[k] = std::max(hi[k], int(c[k]));
@@ -270,10 +288,23 @@ class Refiner {
     int spread = 0;
     for (int k = 0; k < 4; ++k) spread = std::max(spread, hi[k] - lo[k]);
     const float contrast = float(spread) * (1.0f / 255.0f);
-    const Cell& cell = cells_(x, y);
-    const float priority = (contrast + options_.floor + options_.line_weight * cell.importance) * level_share_[level];
+    const Cell& cell = cells_.pixels[r.pixel];
+    const float priority =
+        (contrast + options_.floor + options_.line_weight * cell.importance) * level_share_[r.level];
     if (priority <= 1.05f * cell.offered) return;  // see push()
-    out.push_back({std::uint32_t(y) * std::uint32_t(imp_.width) + std::uint32_t(x), priority});
+    out.push_back({r.pixel, priority});
+  }
+
+  // Lists the candidates of `count` sources with list(source, ready), then evaluates them, a few sources at a
+  // time so the prefetched cells are still cached.
+  template <typename List>
+  void evaluate_all(std::size_t count, const List& list, std::vector<Candidate>& out) const {
+    std::vector<Ready> ready;
+    for (std::size_t first = 0; first < count; first += 64) {
+      ready.clear();
+      for (std::size_t i = first; i < std::min(count, first + 64); ++i) list(i, ready);
+      for (const Ready& r : ready) evaluate(r, out);
+    }
   }
 
   void push(const std::vector<Candidate>& candidates) {
