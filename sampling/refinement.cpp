@@ -61,8 +61,7 @@ void sort_by_key(It first, It last, const Key& key) {
 class BucketQueue {
  public:
   explicit BucketQueue(std::uint64_t seed) : buckets_(kBuckets), seed_(seed) {}
-  void push(float priority, std::uint32_t pixel) {
-    const int b = bucket_of(priority);
+  void push(int b, std::uint32_t pixel) {  ///< b = bucket_of(priority)
     buckets_[b].push_back(pixel);
     top_ = std::min(top_, b);
     ++size_;
@@ -142,6 +141,7 @@ struct Ready {
 struct Candidate {
   std::uint32_t pixel;
   float priority;
+  int bucket;  ///< bucket_of(priority), computed in the parallel part
 };
 
 // Runs chunk(first, last, out) over [0, n) in fixed chunks in parallel and concatenates the outputs in chunk
@@ -292,7 +292,7 @@ class Refiner {
     const float priority =
         (contrast + options_.floor + options_.line_weight * cell.importance) * level_share_[r.level];
     if (priority <= 1.05f * cell.offered) return;  // see push()
-    out.push_back({r.pixel, priority});
+    out.push_back({r.pixel, priority, bucket_of(priority)});
   }
 
   // Lists the candidates of `count` sources with list(source, ready), then evaluates them, a few sources at a
@@ -308,11 +308,13 @@ class Refiner {
   }
 
   void push(const std::vector<Candidate>& candidates) {
-    for (const Candidate& c : candidates) {
+    for (std::size_t i = 0; i < candidates.size(); ++i) {
+      const Candidate& c = candidates[i];
+      if (i + 16 < candidates.size()) __builtin_prefetch(&cells_.pixels[candidates[i + 16].pixel]);
       // Offered again when another parent was traced: only a clearly higher priority is worth a second entry.
       float& offered = cells_.pixels[c.pixel].offered;
       if (c.priority <= 1.05f * offered) continue;
-      queue_.push(c.priority, c.pixel);
+      queue_.push(c.bucket, c.pixel);
       offered = c.priority;
     }
   }
