@@ -18,25 +18,6 @@ int log2_exact(int v) {
 }
 }  // namespace
 
-int fractal_level(int x, int y, int base_spacing) {
-  if (x % base_spacing == 0 && y % base_spacing == 0) return 0;
-  const int levels_below = log2_exact(base_spacing);
-  // The coarsest h (power of two below S) that divides both coordinates decides the level: the pixel is
-  // a centre of a square (both x/h, y/h odd) or of a diamond (exactly one odd) of half-size h.
-  for (int m = 0, h = base_spacing / 2; m < levels_below; ++m, h /= 2) {
-    if (x % h != 0 || y % h != 0) continue;
-    const bool square_centre = (x / h) % 2 == 1 && (y / h) % 2 == 1;
-    return square_centre ? 2 * m + 1 : 2 * m + 2;
-  }
-  RAYSIFT_CHECK(false);  // h = 1 divides everything
-  return 0;
-}
-
-int parent_offset(int level, int base_spacing) {
-  RAYSIFT_DCHECK(level >= 1);
-  return base_spacing >> ((level + 1) / 2);
-}
-
 float pattern_priority(int level, int num_levels) { return 1.0f - float(level) / float(num_levels); }
 
 FractalPattern make_fractal_pattern(int width, int height, int base_spacing) {

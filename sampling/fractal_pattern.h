@@ -21,7 +21,16 @@ struct FractalPattern {
 FractalPattern make_fractal_pattern(int width, int height, int base_spacing = 8);
 
 /// Level of pixel (x,y) for a lattice of spacing S anchored at (0,0). \pre x, y >= 0, S a power of two.
-int fractal_level(int x, int y, int base_spacing);
+/// Inline and branch-light: the refinement asks it for every candidate child.
+inline int fractal_level(int x, int y, int base_spacing) {
+  // The coarsest h < S dividing both coordinates (the lowest set bit of x|y) decides the level: the pixel is
+  // the centre of a square (x/h and y/h odd) or of a diamond (exactly one odd) of half-size h = S >> (m+1).
+  const unsigned bits = unsigned(x | y) & unsigned(base_spacing - 1);
+  if (bits == 0) return 0;
+  const unsigned h = bits & (0u - bits);
+  const int m = __builtin_ctz(unsigned(base_spacing)) - 1 - __builtin_ctz(h);
+  return (unsigned(x) & h) != 0 && (unsigned(y) & h) != 0 ? 2 * m + 1 : 2 * m + 2;
+}
 
 /// Pattern priority p_patt: 1 at level 0, falling linearly by 1/num_levels per level (the finest level
 /// keeps 1/num_levels > 0).
@@ -29,6 +38,7 @@ float pattern_priority(int level, int num_levels);
 
 /// Half-distance h to the four parents of a pixel at `level` >= 1: odd levels (square centres) have
 /// parents at (x±h, y±h), even levels (diamond centres) at (x±h, y) and (x, y±h).
-int parent_offset(int level, int base_spacing);
+/// \pre level >= 1. Inline: the refinement asks it for every candidate.
+inline int parent_offset(int level, int base_spacing) { return base_spacing >> ((level + 1) / 2); }
 
 }  // namespace raysift::sampling

@@ -6,6 +6,7 @@
 #include <mutex>
 
 #include "core/errors.h"
+#include "core/parallel.h"
 #include "sampling/reconstruction.h"
 
 namespace raysift::sampling {
@@ -20,9 +21,14 @@ void require_finite_importance(const ImageF& importance) {
                          std::to_string(i / std::size_t(importance.width)) + ")");
 }
 
-ImageMask background_known(const ImageF& importance) {
+// Background or (with `traced`) traced pixels: what the reconstruction must not change.
+ImageMask background_known(const ImageF& importance, const ImageMask* traced = nullptr) {
   ImageMask known(importance.width, importance.height, 0);
-  for (std::size_t i = 0; i < importance.size(); ++i) known.pixels[i] = importance.pixels[i] < 0 ? 1 : 0;
+  parallel_rows(importance.height, [&](int y) {
+    const std::size_t row = std::size_t(y) * std::size_t(importance.width);
+    for (std::size_t i = row; i < row + std::size_t(importance.width); ++i)
+      known.pixels[i] = importance.pixels[i] < 0 || (traced && traced->pixels[i]) ? 1 : 0;
+  });
   return known;
 }
 
@@ -58,12 +64,16 @@ void trace_selection(const ImageMask& selected, const TraceBatch& trace, Sampled
 // The counts without building the pattern (the subsample and full modes do not need it).
 ObjectCounts count_object_pixels(const ImageF& importance, int spacing) {
   ObjectCounts c;
-  for (int y = 0; y < importance.height; ++y)
-    for (int x = 0; x < importance.width; ++x) {
-      if (importance(x, y) < 0) continue;
-      ++c.object;
-      c.level0 += x % spacing == 0 && y % spacing == 0 ? 1 : 0;
-    }
+  const int mask = spacing - 1;  // validate(): a power of two
+  for (int y = 0; y < importance.height; ++y) {
+    const float* row = &importance.pixels[std::size_t(y) * std::size_t(importance.width)];
+    std::size_t object = 0, level0 = 0;
+    for (int x = 0; x < importance.width; ++x) object += row[x] >= 0 ? 1 : 0;
+    if ((y & mask) == 0)
+      for (int x = 0; x < importance.width; x += spacing) level0 += row[x] >= 0 ? 1 : 0;
+    c.object += object;
+    c.level0 += level0;
+  }
   return c;
 }
 
@@ -226,8 +236,7 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
 
   stage.reset();
   if (frame.rays_traced < counts.object) {
-    ImageMask known = background_known(importance);
-    for (std::size_t i = 0; i < known.size(); ++i) known.pixels[i] |= frame.traced.pixels[i];
+    const ImageMask known = background_known(importance, &frame.traced);
     reconstruct_fractal(frame.image, known, pattern, options.interpolation);
   }
   frame.reconstruct_ms = stage.elapsed_ms();

@@ -1,11 +1,15 @@
 #include "sampling/refinement.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <vector>
 
 #include "core/errors.h"
+#include "core/parallel.h"
 #include "core/timer.h"
 #include "sampling/ray_order.h"
 
@@ -25,21 +29,39 @@ int bucket_of(float priority) {
   return std::min(kBuckets - 1, std::max(0, b + 2 * kBucketsPerOctave));  // priorities up to 4 get bucket >= 0
 }
 
+// Ascending order of `keys`: LSD radix sort, 11 bits a pass over the bits in use, for the large rounds (the
+// same order std::sort gives: it is a sort of plain integers).
+void sort_keys(std::vector<std::uint64_t>& keys) {
+  if (keys.size() < 1024) {
+    std::sort(keys.begin(), keys.end());
+    return;
+  }
+  std::uint64_t used = 0;
+  for (std::uint64_t k : keys) used |= k;
+  std::vector<std::uint64_t> tmp(keys.size());
+  for (int shift = 0; shift < 64 && (used >> shift) != 0; shift += 11) {
+    std::array<std::size_t, 2049> start{};
+    for (std::uint64_t k : keys) ++start[((k >> shift) & 2047u) + 1];
+    for (std::size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+    for (std::uint64_t k : keys) tmp[start[(k >> shift) & 2047u]++] = k;
+    keys.swap(tmp);
+  }
+}
+
 // Sorts [first, last) by key(pixel), each key computed once (the keys hash, so a comparator would rehash).
 template <typename It, typename Key>
 void sort_by_key(It first, It last, const Key& key) {
   std::vector<std::uint64_t> keyed;
   keyed.reserve(std::size_t(last - first));
   for (It it = first; it != last; ++it) keyed.push_back(key(*it));
-  std::sort(keyed.begin(), keyed.end());
+  sort_keys(keyed);
   for (std::uint64_t k : keyed) *first++ = std::uint32_t(k & 0xFFFFFFFFu);
 }
 
 class BucketQueue {
  public:
   explicit BucketQueue(std::uint64_t seed) : buckets_(kBuckets), seed_(seed) {}
-  void push(float priority, std::uint32_t pixel) {
-    const int b = bucket_of(priority);
+  void push(int b, std::uint32_t pixel) {  ///< b = bucket_of(priority)
     buckets_[b].push_back(pixel);
     top_ = std::min(top_, b);
     ++size_;
@@ -88,49 +110,109 @@ std::array<std::array<int, 2>, 4> parent_offsets(int level, int spacing) {
   return {{{-d, 0}, {d, 0}, {0, -d}, {0, d}}};
 }
 
+// What an offer reads and writes of a pixel whose parents are known, in one 16-byte record: offers touch
+// scattered pixels, and separate images would cost a cache miss each.
+struct alignas(16) Cell {
+  /// record()ed values of a traced pixel in 1/255 steps; 0 on background, like its image.
+  std::array<std::uint8_t, 4> percept{};
+  std::uint32_t unused = 0;
+  float importance = 0;    ///< p_imp
+  float offered = 0;       ///< highest priority offered so far (0 = never)
+};
+
+// This thread's w x h image of P, contents unspecified: the refinement's 22 MB of state (at 1440x900) is
+// reused from frame to frame, as a fresh allocation costs a page fault every 4 KB.
+template <typename P>
+Image<P>& frame_buffer(int w, int h) {
+  thread_local Image<P> buffer;
+  if (buffer.width != w || buffer.height != h) buffer = Image<P>(w, h);
+  return buffer;
+}
+
+// A candidate whose corners are known, with its known parents.
+struct Ready {
+  std::uint32_t pixel;
+  int level;
+  int known;  ///< parents[0, known)
+  std::array<std::uint32_t, 4> parents;
+};
+
+// A candidate pixel and the priority its parents give it now.
+struct Candidate {
+  std::uint32_t pixel;
+  float priority;
+  int bucket;  ///< bucket_of(priority), computed in the parallel part
+};
+
+// Runs chunk(first, last, out) over [0, n) in fixed chunks in parallel and concatenates the outputs in chunk
+// order, so the result does not depend on the thread count.
+template <typename Chunk>
+std::vector<Candidate> gather(std::size_t n, std::size_t chunk_size, const Chunk& chunk) {
+  const std::size_t chunks = (n + chunk_size - 1) / chunk_size;
+  std::vector<std::vector<Candidate>> parts(chunks);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t c = r.begin(); c < r.end(); ++c) chunk(c * chunk_size, std::min(n, (c + 1) * chunk_size), parts[c]);
+  });
+  std::vector<Candidate> out;
+  for (const std::vector<Candidate>& part : parts) out.insert(out.end(), part.begin(), part.end());
+  return out;
+}
+
+// Offers are evaluated in parallel and fed to the queue serially. This is exact: between two rounds no offer
+// changes what another offer reads (the traced set and the samples are fixed), so a candidate offered twice in a
+// round gets the same priority twice, and the queue sorts what a bucket received between two serves by hash.
 class Refiner {
  public:
   Refiner(const ImageF& importance, const FractalPattern& pattern, const RefinementOptions& options,
           std::uint64_t seed, ImageRGBA& image, ImageMask& traced)
       : imp_(importance), pattern_(pattern), options_(options), image_(image), traced_(traced),
-        taken_(importance.width, importance.height, 0), offered_(importance.width, importance.height, 0.0f),
-        percept_(importance.width, importance.height, std::array<std::uint8_t, 4>{}),
-        queue_(seed) {}
+        cells_(frame_buffer<Cell>(importance.width, importance.height)),
+        state_(frame_buffer<std::uint8_t>(importance.width, importance.height)), queue_(seed) {
+    parallel_rows(imp_.height, [this](int y) {
+      for (int x = 0; x < imp_.width; ++x) {
+        Cell cell;
+        cell.importance = imp_(x, y);
+        cells_(x, y) = cell;
+        state_(x, y) = imp_(x, y) < 0 || traced_(x, y) ? kKnown : 0;
+      }
+    });
+    for (int l = 0; l < int(level_share_.size()); ++l) level_share_[l] = std::ldexp(1.0f, -l);
+  }
 
-  bool known(int x, int y) const { return imp_(x, y) < 0 || traced_(x, y); }
 
   // Candidates no traced parent will offer: every in-image parent is background.
   void offer_orphans() {
-    for (int y = 0; y < imp_.height; ++y)
-      for (int x = 0; x < imp_.width; ++x) {
-        const int level = pattern_.level(x, y);
-        if (level == 0 || imp_(x, y) < 0) continue;
-        bool orphan = true;
-        for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
-          const int px = x + o[0], py = y + o[1];
-          orphan = orphan && (px < 0 || py < 0 || px >= imp_.width || py >= imp_.height || imp_(px, py) < 0);
+    push(gather(std::size_t(imp_.height), 16, [this](std::size_t y0, std::size_t y1, std::vector<Candidate>& out) {
+      std::vector<Ready> ready;
+      for (int y = int(y0); y < int(y1); ++y)
+        for (int x = 0; x < imp_.width; ++x) {
+          const int level = pattern_.level(x, y);
+          if (level == 0 || imp_(x, y) < 0) continue;
+          bool orphan = true;
+          for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
+            const int px = x + o[0], py = y + o[1];
+            orphan = orphan && (px < 0 || py < 0 || px >= imp_.width || py >= imp_.height || imp_(px, py) < 0);
+          }
+          if (orphan) list_ready(x, y, level, ready);
         }
-        if (orphan) offer(x, y);
-      }
+      for (const Ready& r : ready) evaluate(r, out);
+    }));
   }
 
-  // A traced pixel's values as the contrast sees them: RGB through a square root (close to sRGB), alpha,
-  // quantised to 1/255 (finer than any floor worth setting).
-  void record(std::uint32_t pixel) {
-    const Rgba& c = image_.pixels[pixel];
-    auto code = [](float v) { return std::uint8_t(std::lround(255.0f * std::min(1.0f, std::max(0.0f, v)))); };
-    percept_.pixels[pixel] = {code(std::sqrt(std::max(0.0f, c.r))), code(std::sqrt(std::max(0.0f, c.g))),
-                              code(std::sqrt(std::max(0.0f, c.b))), code(c.a)};
-  }
-
-  // After `pixel` was traced: the children it may have completed, at every finer level.
-  void offer_children(std::uint32_t pixel) {
-    const int w = imp_.width, qx = int(pixel % std::uint32_t(w)), qy = int(pixel / std::uint32_t(w));
-    for (int level = pattern_.level(qx, qy) + 1; level < pattern_.num_levels; ++level)
-      for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
-        const int x = qx - o[0], y = qy - o[1];
-        if (x >= 0 && y >= 0 && x < w && y < imp_.height && pattern_.level(x, y) == level) offer(x, y);
-      }
+  // `pixels` were traced: marks and record()s them, then offers the children they may have completed.
+  void add_traced(const std::vector<std::uint32_t>& pixels) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pixels.size(), 1024),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t i = r.begin(); i < r.end(); ++i) {
+                          traced_.pixels[pixels[i]] = 1;
+                          state_.pixels[pixels[i]] |= kKnown;
+                          record(pixels[i]);
+                        }
+                      });
+    push(gather(pixels.size(), 1024, [&](std::size_t first, std::size_t last, std::vector<Candidate>& out) {
+      evaluate_all(last - first, [&](std::size_t i, std::vector<Ready>& ready) { children(pixels[first + i], ready); },
+                   out);
+    }));
   }
 
   // The best `count` waiting candidates; stale entries (a pixel re-offered at a higher priority, or taken) skipped.
@@ -138,8 +220,8 @@ class Refiner {
     std::vector<std::uint32_t> batch;
     while (batch.size() < count && queue_.size() > 0)
       for (std::uint32_t p : queue_.pop(count - batch.size()))
-        if (!taken_.pixels[p]) {
-          taken_.pixels[p] = 1;
+        if (!(state_.pixels[p] & kTaken)) {
+          state_.pixels[p] |= kTaken;
           batch.push_back(p);
         }
     return batch;
@@ -148,36 +230,93 @@ class Refiner {
   std::size_t waiting() const { return queue_.size(); }
 
  private:
-  void offer(int x, int y) {
-    if (known(x, y) || taken_(x, y)) return;
-    const int level = pattern_.level(x, y), lattice = 2 * parent_offset(level, pattern_.base_spacing);
-    std::array<float, 4> lo{INFINITY, INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY, -INFINITY};
+  // A traced pixel's values as the contrast sees them: RGB through a square root (close to sRGB), alpha,
+  // quantised to 1/255 (finer than any floor worth setting).
+  void record(std::uint32_t pixel) {
+    const Rgba& c = image_.pixels[pixel];
+    auto code = [](float v) { return std::uint8_t(std::lround(255.0f * std::min(1.0f, std::max(0.0f, v)))); };
+    cells_.pixels[pixel].percept = {code(std::sqrt(std::max(0.0f, c.r))), code(std::sqrt(std::max(0.0f, c.g))),
+                              code(std::sqrt(std::max(0.0f, c.b))), code(c.a)};
+  }
+
+  // After `pixel` was traced: the children it may have completed, at every finer level.
+  void children(std::uint32_t pixel, std::vector<Ready>& ready) const {
+    const int w = imp_.width, qx = int(pixel % std::uint32_t(w)), qy = int(pixel / std::uint32_t(w));
+    for (int level = fractal_level(qx, qy, pattern_.base_spacing) + 1; level < pattern_.num_levels; ++level)
+      for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
+        const int x = qx - o[0], y = qy - o[1];
+        if (x >= 0 && y >= 0 && x < w && y < imp_.height && fractal_level(x, y, pattern_.base_spacing) == level)
+          list_ready(x, y, level, ready);
+      }
+  }
+
+  // Appends (x, y) of `level` to `ready` unless it is known, taken or waits for a corner, decided on the small
+  // state_ mask alone (most children asked about wait for a corner), and prefetches the cells its priority
+  // reads: these are scattered, and a chunk's priorities are computed after all its children are listed.
+  void list_ready(int x, int y, int level, std::vector<Ready>& ready) const {
+    if (state_(x, y) != 0) return;
+    const int lattice_mask = 2 * parent_offset(level, pattern_.base_spacing) - 1;
+    Ready r{std::uint32_t(y) * std::uint32_t(imp_.width) + std::uint32_t(x), level, 0, {}};
     for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
       const int px = x + o[0], py = y + o[1];
       if (px < 0 || py < 0 || px >= imp_.width || py >= imp_.height) continue;
       // Required: the corners of the square cell being split (for an edge midpoint, the edge's two ends).
       // The squares' centres beside an edge midpoint only add contrast: requiring them would let a flat
       // neighbour cell block the refinement of an edge cell.
-      const bool corner = px % lattice == 0 && py % lattice == 0;
-      if (!known(px, py)) {
-        if (corner) return;  // offered again when this corner is traced
+      if (!(state_(px, py) & kKnown)) {
+        if ((px & lattice_mask) == 0 && (py & lattice_mask) == 0) return;  // offered again when it is traced
         continue;
       }
-      const std::array<std::uint8_t, 4>& c = percept_(px, py);
-      const std::array<float, 4> v{float(c[0]), float(c[1]), float(c[2]), float(c[3])};
+      r.parents[r.known++] = std::uint32_t(py) * std::uint32_t(imp_.width) + std::uint32_t(px);
+    }
+    for (int i = 0; i < r.known; ++i) __builtin_prefetch(&cells_.pixels[r.parents[i]]);
+    __builtin_prefetch(&cells_.pixels[r.pixel]);
+    ready.push_back(r);
+  }
+
+  // Appends `r` with its priority unless it would not be pushed.
+  void evaluate(const Ready& r, std::vector<Candidate>& out) const {
+    // Per channel in integer 1/255 steps; no known parent leaves hi < lo, contrast 0.
+    std::array<int, 4> lo{255, 255, 255, 255}, hi{0, 0, 0, 0};
+    for (int i = 0; i < r.known; ++i) {
+      const std::array<std::uint8_t, 4>& c = cells_.pixels[r.parents[i]].percept;
       for (int k = 0; k < 4; ++k) {
-        lo[k] = std::min(lo[k], v[k]);
-        hi[k] = std::max(hi[k], v[k]);
+        lo[k] = std::min(lo[k], int(c[k]));
+        hi[k] = std::max(hi[k], int(c[k]));
       }
     }
-    float contrast = 0;
-    for (int k = 0; k < 4; ++k) contrast = std::max(contrast, (hi[k] - lo[k]) * (1.0f / 255.0f));
-    const auto pixel = std::uint32_t(y) * std::uint32_t(imp_.width) + std::uint32_t(x);
-    const float priority = (contrast + options_.floor + options_.line_weight * imp_(x, y)) * std::ldexp(1.0f, -level);
-    // Offered again when another parent was traced: only a clearly higher priority is worth a second entry.
-    if (priority <= 1.05f * offered_(x, y)) return;
-    queue_.push(priority, pixel);
-    offered_(x, y) = priority;
+    int spread = 0;
+    for (int k = 0; k < 4; ++k) spread = std::max(spread, hi[k] - lo[k]);
+    const float contrast = float(spread) * (1.0f / 255.0f);
+    const Cell& cell = cells_.pixels[r.pixel];
+    const float priority =
+        (contrast + options_.floor + options_.line_weight * cell.importance) * level_share_[r.level];
+    if (priority <= 1.05f * cell.offered) return;  // see push()
+    out.push_back({r.pixel, priority, bucket_of(priority)});
+  }
+
+  // Lists the candidates of `count` sources with list(source, ready), then evaluates them, a few sources at a
+  // time so the prefetched cells are still cached.
+  template <typename List>
+  void evaluate_all(std::size_t count, const List& list, std::vector<Candidate>& out) const {
+    std::vector<Ready> ready;
+    for (std::size_t first = 0; first < count; first += 64) {
+      ready.clear();
+      for (std::size_t i = first; i < std::min(count, first + 64); ++i) list(i, ready);
+      for (const Ready& r : ready) evaluate(r, out);
+    }
+  }
+
+  void push(const std::vector<Candidate>& candidates) {
+    for (std::size_t i = 0; i < candidates.size(); ++i) {
+      const Candidate& c = candidates[i];
+      if (i + 16 < candidates.size()) __builtin_prefetch(&cells_.pixels[candidates[i + 16].pixel]);
+      // Offered again when another parent was traced: only a clearly higher priority is worth a second entry.
+      float& offered = cells_.pixels[c.pixel].offered;
+      if (c.priority <= 1.05f * offered) continue;
+      queue_.push(c.bucket, c.pixel);
+      offered = c.priority;
+    }
   }
 
   const ImageF& imp_;
@@ -185,11 +324,11 @@ class Refiner {
   const RefinementOptions& options_;
   ImageRGBA& image_;
   ImageMask& traced_;
-  ImageMask taken_;   ///< popped for tracing
-  ImageF offered_;    ///< highest priority offered so far (0 = never)
-  /// record()ed values of traced pixels in 1/255 steps (4 bytes a pixel); 0 on background, like its image.
-  Image<std::array<std::uint8_t, 4>> percept_;
+  Image<Cell>& cells_;
+  static constexpr std::uint8_t kKnown = 1, kTaken = 2;
+  ImageMask& state_;  ///< kKnown: background or traced; kTaken: popped for tracing
   BucketQueue queue_;
+  std::array<float, 16> level_share_;  ///< 2^-level, the share of the frame one ray of a level covers
 };
 
 // A round in 16x16 tiles, tile rows top to bottom: the caster traces each group of kRayGroup rays together,
@@ -243,14 +382,12 @@ RefinementResult trace_refined(const ImageF& importance, const FractalPattern& p
   const double level0_ms = std::max(1e-3, clock() - level0_start);
   RefinementResult result;
   result.level0 = result.rays = level0.size();
-  for (std::uint32_t p : level0) traced.pixels[p] = 1;
   result.level0_overran = stop.now && (*stop.now)() > stop.deadline_ms;
   double rays_per_ms = double(level0.size()) / level0_ms;
 
   Refiner refiner(importance, pattern, options, seed, image, traced);
-  for (std::uint32_t p : level0) refiner.record(p);
+  refiner.add_traced(level0);  // marks level 0 traced before the orphans are looked for
   refiner.offer_orphans();
-  for (std::uint32_t p : level0) refiner.offer_children(p);
   while (refiner.waiting() > 0) {
     // At most a quarter of the waiting candidates per round, so every round is a choice among them and an
     // edge can be followed down several levels (one per round) before the budget is spent on breadth.
@@ -269,11 +406,7 @@ RefinementResult trace_refined(const ImageF& importance, const FractalPattern& p
       in_tile_order(batch, w);
       trace_all(batch, trace, image);
     }
-    for (std::uint32_t p : batch) {
-      traced.pixels[p] = 1;
-      refiner.record(p);
-    }
-    for (std::uint32_t p : batch) refiner.offer_children(p);
+    refiner.add_traced(batch);
     result.rays += batch.size();
     if (batch.size() < popped) break;  // the deadline cut the round
   }

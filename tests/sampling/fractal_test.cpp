@@ -41,6 +41,21 @@ TEST(FractalPattern, LevelPrefixesFormSquareAndDiamondLattices) {
   }
 }
 
+// fractal_level (bit operations) against in_lattice_state: the level is the first state whose lattice holds
+// the pixel.
+TEST(FractalPattern, LevelIsTheFirstLatticeStateHoldingThePixel) {
+  for (int spacing = 1; spacing <= 128; spacing *= 2) {
+    const int levels = make_fractal_pattern(4, 4, spacing).num_levels;
+    for (int y = 0; y < 300; ++y)
+      for (int x = 0; x < 300; ++x) {
+        int first = 0;
+        while (!in_lattice_state(x, y, first, spacing)) ++first;
+        ASSERT_EQ(fractal_level(x, y, spacing), first) << x << "," << y << " spacing " << spacing;
+        ASSERT_LT(first, levels);
+      }
+  }
+}
+
 TEST(FractalPattern, LevelCountsDoubleFromLevelOne) {
   // On a 64x64 frame (a multiple of 8) levels hold 1,1,2,4,8,16,32 sixty-fourths of the pixels.
   const FractalPattern p = make_fractal_pattern(64, 64, 8);

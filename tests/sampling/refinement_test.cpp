@@ -108,6 +108,33 @@ TEST(Refinement, RaysGoToTheEdgeAndEveryPixelIsTracedOnceAtFractionOne) {
   for (std::size_t i = 0; i < imp.size(); ++i) ASSERT_EQ(count[i], imp.pixels[i] >= 0 ? 1 : 0);
 }
 
+// Rounds of several thousand rays span many of the parallel offer chunks (1024 sources each).
+TEST(Refinement, OneAndTwoThreadsTraceTheSamePixelsInLargeRounds) {
+  constexpr int w = 320, h = 240;
+  ImageF imp(w, h, -1.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      if (std::hypot(x - 160.0, y - 120.0) < 110) imp(x, y) = (x + 2 * y) % 37 == 0 ? 0.9f : 0.0f;
+  const TraceBatch ring = [](Span<const std::uint32_t> pixels, Span<Rgba> out) {
+    for (std::size_t i = 0; i < pixels.size(); ++i) {
+      const double r = std::hypot(double(pixels[i] % w) - 150.0, double(pixels[i] / w) - 110.0);
+      out[i] = int(r / 9) % 2 ? Rgba{0.9f, 0.7f, 0.2f, 1} : Rgba{0.1f, 0.2f, 0.3f, 0.5f};
+    }
+  };
+  const FractalPattern p = make_fractal_pattern(w, h, 8);
+  RefinementStop stop;
+  stop.rays = object_pixels(imp) / 3;
+  auto run = [&](int threads, ImageMask& traced) {
+    ImageRGBA image(w, h);
+    tbb::task_arena arena(threads);
+    arena.execute([&] { trace_refined(imp, p, {}, stop, 7, ring, image, traced); });
+  };
+  ImageMask one(w, h, 0), two(w, h, 0);
+  run(1, one);
+  run(2, two);
+  EXPECT_EQ(one.pixels, two.pixels);
+}
+
 TEST(Refinement, RefinedFrameOfAnAffineImageIsExact) {
   // The samples are affine, so refinement and either reconstruction must give the image back exactly.
   ImageF imp(kW, kH, 0.0f);
