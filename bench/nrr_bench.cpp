@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_data.h"
 #include "core/timer.h"
 #include "mesh/mesh_io.h"
 #include "nrr/metrics.h"
@@ -151,7 +152,7 @@ int main(int argc, char** argv) {
   const int metrics_res = argc > 2 ? std::atoi(argv[2]) : 512;
   const int n_intermediate = argc > 3 ? std::atoi(argv[3]) : 100;
   const std::string real_path =
-      argc > 4 ? argv[4] : "/work/shared/datasets/dragon_tower_with_window_holes_49291v_97374tri.obj";
+      argc > 4 ? argv[4] : raysift::bench::shared_dataset("dragon_tower_with_window_holes_49291v_97374tri.obj");
   const int repeats = 3;
 
   std::vector<BenchScene> scenes;

@@ -8,7 +8,7 @@
 //  * the equal-ray ratios at fractions 0.1/0.2/0.4 as a secondary view;
 //  * budget mode p95 / budget on the engine CT.
 // Scenes: engine CT opaque and translucent (second view), MRI head opaque and translucent, and with --unseen
-// the smoke VDB from /work/shared/datasets with a TF written once (normalised to its value range) and never tuned.
+// the smoke VDB from the shared datasets (bench/bench_data.h) with a TF written once (normalised to its value range) and never tuned.
 // Usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--linear] [--floor F] [--line-weight W]
 //                          [--alpha a00,...,a02] [--budget-frames N]
 #include <algorithm>
@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_data.h"
 #include "core/json_io.h"
 #include "core/timer.h"
 #include "sampling/trade.h"
@@ -332,7 +333,7 @@ int main(int argc, char** argv) {
   }
   if (unseen) {
     // Written once before any run, not tuned: a bright, mostly opaque smoke surface over its value range.
-    const std::string path = "/work/shared/datasets/openvdb_sample_smoke1_density_fog_111x222x112.vdb";
+    const std::string path = raysift::bench::shared_dataset("openvdb_sample_smoke1_density_fog_111x222x112.vdb");
     const volume::Volume vol = volume::load_vdb(path);
     const volume::GridInfo info = vol.info();
     volume::TfJsonOptions tf_options;

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_data.h"
 #include "core/image.h"
 #include "core/json_io.h"
 #include "core/timer.h"
@@ -31,7 +32,7 @@ struct BenchOptions {
   std::string volume = std::string(RAYSIFT_SOURCE_DIR) + "/datasets/engine_ct.vdb";
   std::string tf = std::string(RAYSIFT_SOURCE_DIR) + "/datasets/engine_ct_tf.json";
   std::string camera = std::string(RAYSIFT_SOURCE_DIR) + "/datasets/engine_ct_camera.json";
-  std::string raw = "/work/shared/datasets/engine_ct_256x256x128_u8.raw.gz";
+  std::string raw = raysift::bench::shared_dataset("engine_ct_256x256x128_u8.raw.gz");
   std::string dims = "256,256,128";
   int width = 1440, height = 900;
   double step = 1.0;

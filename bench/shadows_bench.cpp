@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_data.h"
 #include "core/timer.h"
 #include "mesh/tri_mesh.h"
 #include "nrr/scenes.h"
@@ -49,7 +50,7 @@ BenchScene generated(const std::string& name, std::size_t triangles = 0) {
 }
 
 BenchScene engine_ct() {
-  const std::string path = "/work/shared/datasets/engine_ct_256x256x128_u8.raw.gz";
+  const std::string path = raysift::bench::shared_dataset("engine_ct_256x256x128_u8.raw.gz");
   volume::RawLayout layout;
   layout.dims = {256, 256, 128};
   const volume::Volume vol = volume::import_raw(path, layout);
@@ -229,7 +230,7 @@ int main(int argc, char** argv) {
   std::printf("shadows_bench: %d threads%s\n", tbb::this_task_arena::max_concurrency(), cfg.quick ? ", quick" : "");
   std::vector<BenchScene> scenes = {generated("grass"), generated("urban")};
   if (cfg.tables.find_first_of("345") != std::string::npos &&
-      std::filesystem::exists("/work/shared/datasets/engine_ct_256x256x128_u8.raw.gz")) scenes.push_back(engine_ct());
+      std::filesystem::exists(raysift::bench::shared_dataset("engine_ct_256x256x128_u8.raw.gz"))) scenes.push_back(engine_ct());
   if (wants('3'))
     for (const BenchScene& s : scenes) error_table(s, cfg, true);
   if (wants('4'))
