@@ -83,8 +83,8 @@ void validate(const IsoVisibilityOptions& o) {
 
 /// Marches one ray through the block, front to back, marking the iso-values whose first crossing it sees.
 void march(const DenseBlock& b, const StepTransmittance& step, Span<const double> isos, const IsoVisibilityOptions& o,
-           const Vec3d& start, const Vec3d& dir, double length, std::vector<char>& seen) {
-  std::vector<char> crossed(isos.size(), 0);
+           const Vec3d& start, const Vec3d& dir, double length, std::vector<char>& crossed, std::vector<char>& seen) {
+  std::fill(crossed.begin(), crossed.end(), char(0));
   double transmittance = 1.0;
   for (double t = 0; t <= length && transmittance > o.min_transmittance; t += o.step_voxels) {
     const Vec3d p = start + dir * t;
@@ -117,11 +117,12 @@ std::vector<bool> visible_iso_surfaces(const Volume& volume, const TransferFunct
     const Vec3d dir = dirs[d];
     const Vec3d u = normalize(std::abs(dir.x) < 0.9 ? cross(dir, Vec3d(1, 0, 0)) : cross(dir, Vec3d(0, 1, 0)));
     const Vec3d v = cross(dir, u);
+    std::vector<char> crossed(iso_values.size());  // per-ray scratch, allocated once per direction
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i) {
         const double s = radius * (2.0 * (i + 0.5) / n - 1.0), r = radius * (2.0 * (j + 0.5) / n - 1.0);
         const Vec3d start = centre + u * s + v * r - dir * radius;
-        march(block, step, iso_values, options, start, dir, 2 * radius, seen[d]);
+        march(block, step, iso_values, options, start, dir, 2 * radius, crossed, seen[d]);
       }
   };
   if (options.threaded)
