@@ -90,7 +90,7 @@ void print_row(const char* name, const Cost& c, const std::string& note) {
 
 /// Measures the importance buffer and the Embree reference (and `extra`, if given) on one mesh and view.
 template <typename Extra>
-void run_case(const char* title, const mesh::TriMesh& m, const Camera& cam, const features::BackgroundGeometry& bg,
+void run_case(const char* title, const TriMesh& m, const Camera& cam, const features::BackgroundGeometry& bg,
               const Extra& extra) {
   Timer timer;
   const mesh::MeshCurvature curvature = mesh::compute_curvature(m);
@@ -163,7 +163,7 @@ void engine_case() {
   const volume::TransferFunction tf = volume::load_transfer_function(dir + "engine_ct_tf.json");
   const CameraSpec spec = camera_spec_from_json(read_json_file(dir + "engine_ct_camera.json"), "engine camera");
   const double iso = volume::select_iso_values(vol, tf).front().value;
-  const mesh::TriMesh raw = volume::extract_isosurface(vol, iso);
+  const TriMesh raw = volume::extract_isosurface(vol, iso);
   const volume::GridInfo info = vol.info();
   features::BackgroundGeometry bg;
   bg.bbox_ws = Bbox3d{info.bbox_min - info.voxel_size * 0.5, info.bbox_max + info.voxel_size * 0.5};
@@ -173,12 +173,12 @@ void engine_case() {
     // OpenMesh's decimater rejects the few non-manifold spots marching cubes leaves; drop the faces at
     // the vertices the curvature classification marks non-manifold first.
     const mesh::MeshCurvature raw_curvature = mesh::compute_curvature(raw);
-    mesh::TriMesh cleaned;
+    TriMesh cleaned;
     cleaned.positions = raw.positions;
     for (const auto& t : raw.triangles)
       if (raw_curvature.is_valid[t[0]] && raw_curvature.is_valid[t[1]] && raw_curvature.is_valid[t[2]])
         cleaned.triangles.push_back(t);
-    const mesh::TriMesh prepared = mesh::prepare_mesh(cleaned).mesh;
+    const TriMesh prepared = mesh::prepare_mesh(cleaned).mesh;
     std::snprintf(title, sizeof title,
                   "engine CT iso-surface (iso %.1f), prepared (%zu faces at non-manifold vertices dropped; Taubin, "
                   "decimate 10 %%, Taubin)",
@@ -198,7 +198,7 @@ int main(int argc, char** argv) {
     engine_case();
     const std::string path =
         argc > 1 ? argv[1] : RAYSIFT_SOURCE_DIR "/../shared/datasets/stanford_bunny_bun_zipper_35947v_69451tri.ply";
-    const mesh::TriMesh m = mesh::read_mesh(path);
+    const TriMesh m = mesh::read_mesh(path);
     Bbox3d box;
     for (const Vec3f& p : m.positions) box.expand(Vec3d(p));
     CameraSpec spec;

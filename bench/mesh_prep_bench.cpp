@@ -44,7 +44,7 @@ std::pair<double, long> vtk(const std::string& mode, const std::string& ply, lon
 
 /// Points on a simplified surface: its vertices plus each triangle's centroid and edge midpoints (vertices
 /// alone would say nothing about the triangles between).
-std::vector<Vec3f> surface_samples(const mesh::TriMesh& m) {
+std::vector<Vec3f> surface_samples(const TriMesh& m) {
   std::vector<Vec3f> out = m.positions;
   for (const auto& t : m.triangles) {
     const Vec3f a = m.positions[t[0]], b = m.positions[t[1]], c = m.positions[t[2]];
@@ -63,13 +63,13 @@ struct Quality {
   long euler = 0;
 };
 
-Quality quality(const mesh::TriMesh& original, const mesh::TriMesh& simplified) {
+Quality quality(const TriMesh& original, const TriMesh& simplified) {
   const mesh::MeshAnalysis a = mesh::analyze_mesh(simplified);
   return {mesh::max_distance_to_surface(surface_samples(simplified), original),
           mesh::max_distance_to_surface(original.positions, simplified), a.is_watertight(), long(a.euler_characteristic)};
 }
 
-void bench_decimation(const mesh::TriMesh& m, const std::string& ply) {
+void bench_decimation(const TriMesh& m, const std::string& ply) {
   mesh::DecimationOptions dec;
   dec.ratio = 0.1;
   mesh::DecimationResult ours;
@@ -107,7 +107,7 @@ void bench_decimation(const mesh::TriMesh& m, const std::string& ply) {
   std::filesystem::remove(vtk_ply);
 }
 
-void bench(const std::string& label, const mesh::TriMesh& m, int iterations) {
+void bench(const std::string& label, const TriMesh& m, int iterations) {
   const double v = double(m.vertex_count());
   std::printf("\n%s: %zu vertices, %zu triangles, %d iterations\n", label.c_str(), m.vertex_count(), m.triangle_count(),
               iterations);
@@ -155,7 +155,7 @@ void bench(const std::string& label, const mesh::TriMesh& m, int iterations) {
 /// Throughput of one plain meshopt_simplify call (the keep_topology = false path) to 10 % on a 5 M-triangle
 /// closed surface (the size of three full-resolution MRI iso-surfaces).
 void throughput_note() {
-  const mesh::TriMesh torus = mesh::make_torus(100.0, 30.0, 2048, 1280);
+  const TriMesh torus = mesh::make_torus(100.0, 30.0, 2048, 1280);
   std::vector<unsigned> kept(3 * torus.triangle_count());
   Timer t;
   kept.resize(meshopt_simplify(kept.data(), reinterpret_cast<const unsigned*>(torus.triangles.data()), kept.size(),

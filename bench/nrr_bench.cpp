@@ -29,12 +29,12 @@ using namespace raysift;
 
 struct BenchScene {
   std::string name;
-  mesh::TriMesh mesh;
+  TriMesh mesh;
   std::vector<CameraSpec> views;
 };
 
 /// Three eyes on a triangle in front of and above the mesh, looking at its centre.
-std::vector<CameraSpec> views_around(const mesh::TriMesh& m) {
+std::vector<CameraSpec> views_around(const TriMesh& m) {
   Bbox3d box;
   for (const Vec3f& p : m.positions) box.expand(Vec3d(p));
   const Vec3d c = box.center();
@@ -71,7 +71,7 @@ double best_ms(int repeats, F&& f) {
 
 /// Bare Embree: a plain scene, 4x4-pixel packets through rtcIntersect16 over 16x16 tiles, no culling,
 /// no filter, nothing stored but a checksum. The reference the conventional sampler is measured against.
-double bare_embree_ms(const mesh::TriMesh& m, const CameraSpec& spec, int repeats, std::size_t& hits_out) {
+double bare_embree_ms(const TriMesh& m, const CameraSpec& spec, int repeats, std::size_t& hits_out) {
   RTCDevice device = rtcNewDevice(nullptr);
   RTCScene scene = rtcNewScene(device);
   RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -161,7 +161,7 @@ int main(int argc, char** argv) {
     scenes.push_back({kind == nrr::SceneKind::Grass ? "Grass" : "Urban", std::move(g.mesh), g.views.views});
   }
   {
-    mesh::TriMesh real = mesh::read_mesh(real_path);
+    TriMesh real = mesh::read_mesh(real_path);
     const std::string file = real_path.substr(real_path.find_last_of('/') + 1);
     std::vector<CameraSpec> views = views_around(real);
     scenes.push_back({file.substr(0, file.find('_', file.find('_') + 1)), std::move(real), views});

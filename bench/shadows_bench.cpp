@@ -17,7 +17,7 @@
 
 #include "bench/bench_data.h"
 #include "core/timer.h"
-#include "mesh/tri_mesh.h"
+#include "core/tri_mesh.h"
 #include "nrr/scenes.h"
 #include "nrr/shadows.h"
 #include "volume/import.h"
@@ -29,7 +29,7 @@ namespace {
 
 struct BenchScene {
   std::string name;
-  mesh::TriMesh mesh;
+  TriMesh mesh;
   CameraSpec camera;
   Vec3d up;  ///< the scene's up axis: the light hangs above along it
 };

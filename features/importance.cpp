@@ -235,7 +235,7 @@ ImportanceBuffer rasterize_importance(const FeatureLines& visible_lines, const C
   return rasterize(visible_lines, frame, background, options, nullptr);
 }
 
-ImportanceBuffer compute_importance(const mesh::TriMesh& mesh, const mesh::MeshCurvature& curvature,
+ImportanceBuffer compute_importance(const TriMesh& mesh, const mesh::MeshCurvature& curvature,
                                     const Camera& frame, const LineOptions& line_options,
                                     const BackgroundGeometry& background, const ImportanceOptions& options,
                                     FeatureLines* visible_lines, ImportanceTimings* timings) {

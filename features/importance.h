@@ -27,7 +27,7 @@
 #include "features/lines.h"
 #include "features/visibility.h"
 #include "mesh/curvature.h"
-#include "mesh/tri_mesh.h"
+#include "core/tri_mesh.h"
 
 namespace raysift::features {
 
@@ -48,7 +48,7 @@ struct ImportanceOptions {
 /// bounds) and/or a mesh. A pixel is background if its ray misses every given item.
 struct BackgroundGeometry {
   std::optional<Bbox3d> bbox_ws;
-  const mesh::TriMesh* mesh = nullptr;  ///< not owned; may be the line mesh itself
+  const TriMesh* mesh = nullptr;  ///< not owned; may be the line mesh itself
 };
 
 struct ImportanceBuffer {
@@ -82,7 +82,7 @@ struct ImportanceTimings {
 /// `background.mesh == &mesh`), classify exterior silhouettes, rasterise. Curvature is view-independent and passed
 /// in. `visible_lines` and `timings`, when non-null, receive the intermediate results.
 /// \throw InvalidInput as extract_lines and rasterize_importance do.
-ImportanceBuffer compute_importance(const mesh::TriMesh& mesh, const mesh::MeshCurvature& curvature,
+ImportanceBuffer compute_importance(const TriMesh& mesh, const mesh::MeshCurvature& curvature,
                                     const Camera& frame, const LineOptions& line_options,
                                     const BackgroundGeometry& background, const ImportanceOptions& options = {},
                                     FeatureLines* visible_lines = nullptr, ImportanceTimings* timings = nullptr);

@@ -43,7 +43,7 @@ Rgba line_class_colour(LineClass line_class) {
   return {1.0f, 0.0f, 1.0f, 1.0f};
 }
 
-ImageRGBA render_line_picture(const mesh::TriMesh& mesh, const DepthBuffer& depth, const FeatureLines& visible,
+ImageRGBA render_line_picture(const TriMesh& mesh, const DepthBuffer& depth, const FeatureLines& visible,
                               const PictureOptions& options) {
   if (!(options.line_width_px > 0))
     throw InvalidInput("line picture: line_width_px must be > 0, got " + std::to_string(options.line_width_px));

@@ -7,7 +7,7 @@
 #include "core/image.h"
 #include "features/lines.h"
 #include "features/raster.h"
-#include "mesh/tri_mesh.h"
+#include "core/tri_mesh.h"
 
 namespace raysift::features {
 
@@ -23,7 +23,7 @@ struct PictureOptions {
 /// Headlight-shaded grey mesh (from `depth`'s face ids, on white) with the visible lines drawn on top,
 /// strong classes last; each line's opacity grows with its strength (rtsc fading). Same size as `depth`.
 /// \pre `depth` was rendered from `mesh`. \throw InvalidInput if line_width_px <= 0.
-ImageRGBA render_line_picture(const mesh::TriMesh& mesh, const DepthBuffer& depth, const FeatureLines& visible,
+ImageRGBA render_line_picture(const TriMesh& mesh, const DepthBuffer& depth, const FeatureLines& visible,
                               const PictureOptions& options = {});
 
 /// Writes the segments as an SVG of the camera's image size: one <g> per class (id = class name), one

@@ -23,7 +23,7 @@ struct PerView {
   std::vector<float> sh_num;    // −Nsc − T_sh·ndotv (suggestive-highlight test numerator)
 };
 
-PerView compute_per_view(const mesh::TriMesh& mesh, const mesh::MeshCurvature& c, const Vec3d& eye,
+PerView compute_per_view(const TriMesh& mesh, const mesh::MeshCurvature& c, const Vec3d& eye,
                          const LineOptions& o, bool need_kr, bool need_sc, bool need_sh) {
   const std::size_t nv = mesh.vertex_count();
   PerView pv;
@@ -72,7 +72,7 @@ float fade_alpha(float num, float den, float fade) {
 }
 
 struct FaceContext {
-  const mesh::TriMesh& mesh;
+  const TriMesh& mesh;
   std::uint32_t face;
   std::vector<LineSegment>& out;
 
@@ -236,7 +236,7 @@ std::size_t FeatureLines::count(LineClass c) const {
   }));
 }
 
-FeatureLines extract_lines(const mesh::TriMesh& mesh, const mesh::MeshCurvature& curvature, const Vec3d& eye_ws,
+FeatureLines extract_lines(const TriMesh& mesh, const mesh::MeshCurvature& curvature, const Vec3d& eye_ws,
                            const LineOptions& options) {
   if (!is_finite(eye_ws)) throw InvalidInput("feature lines: the eye position is not finite");
   if (curvature.k1.size() != mesh.vertex_count() || curvature.is_valid.size() != mesh.vertex_count())

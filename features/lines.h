@@ -11,7 +11,7 @@
 
 #include "core/vec.h"
 #include "mesh/curvature.h"
-#include "mesh/tri_mesh.h"
+#include "core/tri_mesh.h"
 
 namespace raysift::features {
 
@@ -70,7 +70,7 @@ struct LineOptions {
 /// \pre `curvature` was computed from `mesh` (same vertex count).
 /// \throw InvalidInput if the eye is not finite, a threshold is negative or not finite, or the curvature
 ///        does not match the mesh.
-FeatureLines extract_lines(const mesh::TriMesh& mesh, const mesh::MeshCurvature& curvature, const Vec3d& eye_ws,
+FeatureLines extract_lines(const TriMesh& mesh, const mesh::MeshCurvature& curvature, const Vec3d& eye_ws,
                            const LineOptions& options = {});
 
 }  // namespace raysift::features

@@ -163,7 +163,7 @@ CameraSpec scaled_camera(const CameraSpec& spec, double scale) {
   return s;
 }
 
-DepthBuffer rasterize_depth(const mesh::TriMesh& mesh, const Camera& camera, const RasterOptions& options) {
+DepthBuffer rasterize_depth(const TriMesh& mesh, const Camera& camera, const RasterOptions& options) {
   const int width = camera.width(), height = camera.height();
   DepthBuffer out{camera.spec(), ImageF(width, height, std::numeric_limits<float>::infinity()),
                   ImageU32(width, height, kNoFace)};

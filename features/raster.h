@@ -8,7 +8,7 @@
 
 #include "core/camera.h"
 #include "core/image.h"
-#include "mesh/tri_mesh.h"
+#include "core/tri_mesh.h"
 
 namespace raysift::features {
 
@@ -30,7 +30,7 @@ struct RasterOptions {
 /// count. Degenerate triangles cover no pixel; the near plane sits at 1e-6 × the mesh bbox diagonal in front
 /// of the eye.
 /// \throw InvalidInput if a used vertex is NaN/Inf or an index is out of range.
-DepthBuffer rasterize_depth(const mesh::TriMesh& mesh, const Camera& camera, const RasterOptions& options = {});
+DepthBuffer rasterize_depth(const TriMesh& mesh, const Camera& camera, const RasterOptions& options = {});
 
 /// The same view with both image sides multiplied by `scale` and rounded (at least 1 pixel).
 /// \throw InvalidInput unless 0 < scale <= 1.

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "mesh/tri_mesh.h"
+#include "core/tri_mesh.h"
 #include "volume/transfer_function.h"
 #include "volume/volume.h"
 
@@ -35,7 +35,7 @@ CacheKey feature_cache_key(const volume::Volume& volume, const volume::TransferF
 /// What is cached: the merged prepared mesh and the iso-values that made it.
 struct CachedGeometry {
   std::vector<double> iso_values;
-  mesh::TriMesh mesh;
+  TriMesh mesh;
 };
 
 class FeatureCache {

@@ -83,7 +83,7 @@ std::string box_text(const Vec3d& lo, const Vec3d& hi) {
   return s.str();
 }
 
-void check_bounds(const mesh::TriMesh& m, const volume::Volume& volume, const std::string& path) {
+void check_bounds(const TriMesh& m, const volume::Volume& volume, const std::string& path) {
   Vec3d lo(m.positions.front()), hi(m.positions.front());
   for (const Vec3f& p : m.positions) {
     lo = {std::min(lo.x, double(p.x)), std::min(lo.y, double(p.y)), std::min(lo.z, double(p.z))};

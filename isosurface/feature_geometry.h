@@ -13,14 +13,14 @@
 #include "isosurface/feature_cache.h"
 #include "isosurface/pipeline.h"
 #include "mesh/curvature.h"
-#include "mesh/tri_mesh.h"
+#include "core/tri_mesh.h"
 #include "volume/transfer_function.h"
 #include "volume/volume.h"
 
 namespace raysift::isosurface {
 
 struct FeatureGeometry {
-  mesh::TriMesh mesh;
+  TriMesh mesh;
   mesh::MeshCurvature curvature;
   std::vector<double> iso_values;  ///< the surfaces in `mesh`
   std::vector<double> hidden_iso_values;  ///< chosen, but hidden by the TF from every probe direction: not built

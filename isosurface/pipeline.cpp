@@ -52,10 +52,10 @@ IsosurfaceSet build_isosurfaces(const volume::Volume& volume, const volume::Tran
   timer.reset();
   volume::MarchingCubesOptions mc = options.marching_cubes;
   if (!mc.cancel) mc.cancel = options.cancel;
-  std::vector<mesh::TriMesh> raw = volume::extract_isosurfaces(volume, values, mc);
+  std::vector<TriMesh> raw = volume::extract_isosurfaces(volume, values, mc);
   set.stages.marching_cubes.ms = timer.elapsed_ms();
   std::size_t mc_triangles = 0;
-  for (const mesh::TriMesh& m : raw) mc_triangles += m.triangle_count();
+  for (const TriMesh& m : raw) mc_triangles += m.triangle_count();
   set.stages.marching_cubes.triangles = mc_triangles;
   check_cancel(options);
   if (options.progress) options.progress(0.3);
@@ -91,8 +91,8 @@ IsosurfaceSet build_isosurfaces(const volume::Volume& volume, const volume::Tran
   return set;
 }
 
-mesh::TriMesh merge_surfaces(const IsosurfaceSet& set) {
-  mesh::TriMesh merged;
+TriMesh merge_surfaces(const IsosurfaceSet& set) {
+  TriMesh merged;
   for (const Surface& s : set.surfaces) {
     const auto base = std::uint32_t(merged.positions.size());
     merged.positions.insert(merged.positions.end(), s.mesh.positions.begin(), s.mesh.positions.end());

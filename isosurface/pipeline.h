@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "mesh/mesh_prep.h"
-#include "mesh/tri_mesh.h"
+#include "core/tri_mesh.h"
 #include "volume/iso_values.h"
 #include "volume/marching_cubes.h"
 #include "volume/transfer_function.h"
@@ -40,7 +40,7 @@ struct StageTimes {
 
 struct Surface {
   volume::IsoValue iso;
-  mesh::TriMesh mesh;                   ///< prepared; empty if the iso-value cuts no cell
+  TriMesh mesh;                   ///< prepared; empty if the iso-value cuts no cell
   std::size_t marching_cubes_triangles = 0;
   bool decimation_reached_target = true;
 };
@@ -57,6 +57,6 @@ IsosurfaceSet build_isosurfaces(const volume::Volume& volume, const volume::Tran
                                 const PipelineOptions& options = {});
 
 /// All non-empty surfaces of `set` in one mesh (vertex indices offset), in surface order.
-mesh::TriMesh merge_surfaces(const IsosurfaceSet& set);
+TriMesh merge_surfaces(const IsosurfaceSet& set);
 
 }  // namespace raysift::isosurface

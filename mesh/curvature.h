@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "core/vec.h"
-#include "mesh/tri_mesh.h"
+#include "core/tri_mesh.h"
 
 namespace raysift::mesh {
 

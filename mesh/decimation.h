@@ -8,7 +8,7 @@
 #include <string>
 
 #include "core/span.h"
-#include "mesh/tri_mesh.h"
+#include "core/tri_mesh.h"
 
 namespace raysift::mesh {
 

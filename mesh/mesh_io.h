@@ -4,7 +4,7 @@
 /// in-range indices. Polygons are fan-triangulated by default (see MeshReadOptions).
 #include <string>
 
-#include "mesh/tri_mesh.h"
+#include "core/tri_mesh.h"
 
 namespace raysift::mesh {
 

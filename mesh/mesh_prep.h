@@ -6,7 +6,7 @@
 
 #include "mesh/decimation.h"
 #include "mesh/smoothing.h"
-#include "mesh/tri_mesh.h"
+#include "core/tri_mesh.h"
 
 namespace raysift::mesh {
 

@@ -3,7 +3,7 @@
 /// plane. All are counter-clockwise seen from outside (normals point away from the solid; the plane's
 /// towards +z) and have exact vertex positions on the analytic surface.
 #include "core/vec.h"
-#include "mesh/tri_mesh.h"
+#include "core/tri_mesh.h"
 
 namespace raysift::mesh {
 

@@ -12,7 +12,7 @@
 
 #include "core/span.h"
 #include "core/vec.h"
-#include "mesh/tri_mesh.h"
+#include "core/tri_mesh.h"
 
 namespace raysift::mesh {
 

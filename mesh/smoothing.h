@@ -5,7 +5,7 @@
 /// fixed. With mu = 0 it is plain Laplacian smoothing (one λ pass per iteration), the shrinking reference.
 #include <atomic>
 
-#include "mesh/tri_mesh.h"
+#include "core/tri_mesh.h"
 
 namespace raysift::mesh {
 

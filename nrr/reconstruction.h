@@ -13,7 +13,7 @@
 
 #include "core/camera.h"
 #include "core/vec.h"
-#include "mesh/tri_mesh.h"
+#include "core/tri_mesh.h"
 #include "nrr/depth_image.h"
 
 namespace raysift::nrr {
@@ -37,7 +37,7 @@ struct ReconstructionStats {
 };
 
 struct Reconstruction {
-  mesh::TriMesh mesh;  ///< world space; orientation of triangles unspecified (shadow maps draw both)
+  TriMesh mesh;  ///< world space; orientation of triangles unspecified (shadow maps draw both)
   ReconstructionStats stats;
 };
 

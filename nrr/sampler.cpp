@@ -35,7 +35,7 @@ constexpr double kCreaseAngleDeg = 45.0;
 constexpr double kFlatCosine = 1.0 - 1e-6;
 }  // namespace
 
-SampledScene::SampledScene(const mesh::TriMesh& mesh) : rays_(mesh) {
+SampledScene::SampledScene(const TriMesh& mesh) : rays_(mesh) {
   const std::size_t n_tris = mesh.triangle_count();
   face_normals_.reserve(n_tris);
   std::vector<Vec3d> area_normals;

@@ -11,7 +11,7 @@
 #include "core/camera.h"
 #include "core/span.h"
 #include "mesh/ray_scene.h"
-#include "mesh/tri_mesh.h"
+#include "core/tri_mesh.h"
 #include "nrr/depth_image.h"
 
 namespace raysift::nrr {
@@ -28,7 +28,7 @@ std::string to_string(SamplingMode mode);
 class SampledScene {
  public:
   /// \throw InvalidInput for an empty mesh, a NaN/Inf vertex or an out-of-range index.
-  explicit SampledScene(const mesh::TriMesh& mesh);
+  explicit SampledScene(const TriMesh& mesh);
 
   const mesh::RayScene& rays() const { return rays_; }
   /// Unit normal of the CCW front face (zero for a degenerate triangle).

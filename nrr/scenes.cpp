@@ -19,19 +19,19 @@ double uniform(std::uint64_t index, std::uint64_t seed, std::uint64_t stream) {
   return double(mix64(mix64(mix64(seed) ^ index) + stream) >> 11) * (1.0 / 9007199254740992.0);
 }
 
-std::uint32_t add_vertex(mesh::TriMesh& m, const Vec3d& p) {
+std::uint32_t add_vertex(TriMesh& m, const Vec3d& p) {
   m.positions.push_back(Vec3f(p));
   return std::uint32_t(m.positions.size() - 1);
 }
 
 /// Quad a b c d, counter-clockwise seen from its front, as two triangles.
-void add_quad(mesh::TriMesh& m, std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d) {
+void add_quad(TriMesh& m, std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d) {
   m.triangles.push_back({a, b, c});
   m.triangles.push_back({a, c, d});
 }
 
 /// Axis-aligned box with outward faces; the floor (y = lo.y) is left out when `has_floor` is false.
-void add_box(mesh::TriMesh& m, const Vec3d& lo, const Vec3d& hi, bool has_floor = true) {
+void add_box(TriMesh& m, const Vec3d& lo, const Vec3d& hi, bool has_floor = true) {
   std::uint32_t v[8];
   for (int i = 0; i < 8; ++i) v[i] = add_vertex(m, {i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z});
   add_quad(m, v[0], v[2], v[3], v[1]);  // -z
@@ -42,7 +42,7 @@ void add_box(mesh::TriMesh& m, const Vec3d& lo, const Vec3d& hi, bool has_floor 
   add_quad(m, v[1], v[3], v[7], v[5]);  // +x
 }
 
-void add_ground(mesh::TriMesh& m, double half) {
+void add_ground(TriMesh& m, double half) {
   const std::uint32_t a = add_vertex(m, {-half, 0, half}), b = add_vertex(m, {half, 0, half}),
                       c = add_vertex(m, {half, 0, -half}), d = add_vertex(m, {-half, 0, -half});
   add_quad(m, a, b, c, d);
@@ -59,7 +59,7 @@ CameraSpec view(const Vec3d& eye, const Vec3d& target, double fov_y_deg) {
 
 GeneratedScene make_blocks4() {
   GeneratedScene s;
-  mesh::TriMesh& m = s.mesh;
+  TriMesh& m = s.mesh;
   const double h = 1.5;  // blocks span y in [-h, h]; the eyes at y = 0 see no top or bottom face
   add_box(m, {-0.2, -h, 5.5}, {0.2, h, 6.0});   // A: hides C from the midpoint of the eyes
   add_box(m, {-0.3, -h, 2.8}, {1.8, h, 3.0});   // B: hides C from V1 and, behind A, from the midpoint
@@ -86,7 +86,7 @@ constexpr int kTrianglesPerBuilding = 10;
 
 GeneratedScene make_grass(std::uint64_t seed, std::size_t triangles) {
   GeneratedScene s;
-  mesh::TriMesh& m = s.mesh;
+  TriMesh& m = s.mesh;
   const double half = 5.0;
   add_ground(m, half);
   const std::size_t blades = (triangles - 2) / kTrianglesPerBlade;
@@ -129,7 +129,7 @@ GeneratedScene make_grass(std::uint64_t seed, std::size_t triangles) {
 
 GeneratedScene make_urban(std::uint64_t seed, std::size_t triangles) {
   GeneratedScene s;
-  mesh::TriMesh& m = s.mesh;
+  TriMesh& m = s.mesh;
   const double half = 5.0;
   add_ground(m, half);
   const std::size_t buildings = (triangles - 2) / kTrianglesPerBuilding;

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string>
 
-#include "mesh/tri_mesh.h"
+#include "core/tri_mesh.h"
 #include "nrr/views.h"
 
 namespace raysift::nrr {
@@ -23,7 +23,7 @@ struct SceneOptions {
 };
 
 struct GeneratedScene {
-  mesh::TriMesh mesh;  ///< world units, y up
+  TriMesh mesh;  ///< world units, y up
   ViewSet views;       ///< suggested reference views (blocks4 also has its intermediate view)
 };
 

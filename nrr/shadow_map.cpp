@@ -66,7 +66,7 @@ ShadowFrustum fit_shadow_frustum(const Vec3d& eye_ws, Span<const Vec3d> points, 
   return f;
 }
 
-void ShadowMap::render(const ShadowFrustum& frustum, Span<const mesh::TriMesh* const> meshes) {
+void ShadowMap::render(const ShadowFrustum& frustum, Span<const TriMesh* const> meshes) {
   RAYSIFT_CHECK(frustum.resolution >= 1);
   frustum_ = frustum;
   const int res = frustum.resolution;
@@ -81,7 +81,7 @@ void ShadowMap::render(const ShadowFrustum& frustum, Span<const mesh::TriMesh* c
     sy = (f.y * iz - frustum.tan_y_min) * scale_y;
   };
 
-  for (const mesh::TriMesh* m : meshes) {
+  for (const TriMesh* m : meshes) {
     // Each vertex is transformed and projected once; only triangles crossing the near plane are
     // clipped and re-projected.
     vertices_.resize(m->positions.size());

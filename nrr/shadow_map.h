@@ -11,7 +11,7 @@
 
 #include "core/span.h"
 #include "core/vec.h"
-#include "mesh/tri_mesh.h"
+#include "core/tri_mesh.h"
 
 namespace raysift::nrr {
 
@@ -47,7 +47,7 @@ class ShadowMap {
  public:
   /// Renders the nearest view depth of all triangles of `meshes` (both faces; degenerate triangles
   /// skipped). \pre frustum.resolution >= 1, every vertex finite.
-  void render(const ShadowFrustum& frustum, Span<const mesh::TriMesh* const> meshes);
+  void render(const ShadowFrustum& frustum, Span<const TriMesh* const> meshes);
 
   /// True if p is lit: outside the map, nothing rendered at its texel, or no farther than the stored
   /// depth plus the bias. `normal` is the receiver's unit normal facing the light side.

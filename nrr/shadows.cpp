@@ -47,7 +47,7 @@ void validate(const ShadowOptions& o) {
 }
 // Steps 1 and 2 of NRR Alg. 5: depth images from the light (plus the corner images H for the hybrid
 // reconstruction, rendered with the same sampler from the corner cameras) and one mesh per image.
-std::vector<mesh::TriMesh> discretize_and_reconstruct(const SampledScene& scene, const AreaLight& light,
+std::vector<TriMesh> discretize_and_reconstruct(const SampledScene& scene, const AreaLight& light,
                                                       ShadowMethod method, const ShadowOptions& options,
                                                       ShadowResult& result) {
   const std::vector<CameraSpec> views = light_corner_views(light, scene.rays().bounds(), options.depth_image_resolution);
@@ -77,7 +77,7 @@ std::vector<mesh::TriMesh> discretize_and_reconstruct(const SampledScene& scene,
   for (const DepthImage& image : corners) result.corner_samples += image.sample_count();
 
   timer.reset();
-  std::vector<mesh::TriMesh> meshes(images.size());
+  std::vector<TriMesh> meshes(images.size());
   std::vector<ReconstructionStats> stats(images.size());
   tbb::parallel_for(std::size_t(0), images.size(), [&](std::size_t i) {
     Reconstruction r = hybrid ? reconstruct_hybrid(images[i], corners[i], options.reconstruction)
@@ -190,7 +190,7 @@ VisibilitySet raytraced_visibility(const mesh::RayScene& scene, const Receivers&
   return vis;
 }
 
-VisibilitySet shadow_map_visibility(Span<const mesh::TriMesh* const> occluders, const Bbox3d& scene_bounds,
+VisibilitySet shadow_map_visibility(Span<const TriMesh* const> occluders, const Bbox3d& scene_bounds,
                                     const Receivers& receivers, Span<const Vec3d> samples_ws, const AreaLight& light,
                                     const ShadowOptions& options) {
   const int pixels = receivers.width * receivers.height;
@@ -293,7 +293,7 @@ CameraSpec default_shadow_camera(const AreaLight& light, const Bbox3d& bounds, i
   return c;
 }
 
-ShadowResult render_shadows(const mesh::TriMesh& mesh, const SampledScene& scene, const Receivers& receivers,
+ShadowResult render_shadows(const TriMesh& mesh, const SampledScene& scene, const Receivers& receivers,
                             const AreaLight& light, ShadowMethod method, const ShadowOptions& options) {
   validate(options);
   const Bbox3d bounds = scene.rays().bounds();
@@ -311,21 +311,21 @@ ShadowResult render_shadows(const mesh::TriMesh& mesh, const SampledScene& scene
     result.times_ms.shadows = timer.elapsed_ms();
     return result;
   }
-  std::vector<const mesh::TriMesh*> occluders = {&mesh};
-  std::vector<mesh::TriMesh> reconstructed;
+  std::vector<const TriMesh*> occluders = {&mesh};
+  std::vector<TriMesh> reconstructed;
   if (method != ShadowMethod::ShadowMap) {
     reconstructed = discretize_and_reconstruct(scene, light, method, options, result);
     occluders.clear();
-    for (const mesh::TriMesh& m : reconstructed)
+    for (const TriMesh& m : reconstructed)
       if (!m.empty()) occluders.push_back(&m);
     if (occluders.empty())
       throw InvalidInput("the " + to_string(method) + " reconstruction is empty: the depth images from the light "
                          "see no geometry (is the light inside geometry or facing away?)");
   }
-  for (const mesh::TriMesh* m : occluders) result.occluder_triangles += m->triangle_count();
+  for (const TriMesh* m : occluders) result.occluder_triangles += m->triangle_count();
   result.shadow_map_texels = std::size_t(options.shadow_map_resolution) * std::size_t(options.shadow_map_resolution);
   timer.reset();
-  result.visibility = shadow_map_visibility(Span<const mesh::TriMesh* const>(occluders), bounds, receivers,
+  result.visibility = shadow_map_visibility(Span<const TriMesh* const>(occluders), bounds, receivers,
                                             Span<const Vec3d>(samples), light, options);
   result.times_ms.shadows = timer.elapsed_ms();
   return result;

@@ -15,7 +15,7 @@
 #include "core/span.h"
 #include "core/vec.h"
 #include "mesh/ray_scene.h"
-#include "mesh/tri_mesh.h"
+#include "core/tri_mesh.h"
 #include "nrr/area_light.h"
 #include "nrr/reconstruction.h"
 #include "nrr/sampler.h"
@@ -100,7 +100,7 @@ VisibilitySet raytraced_visibility(const mesh::RayScene& scene, const Receivers&
 
 /// Visibility by one shadow map per light sample rendered from `occluders`; `scene_bounds` is what the
 /// SceneBounds fit encloses.
-VisibilitySet shadow_map_visibility(Span<const mesh::TriMesh* const> occluders, const Bbox3d& scene_bounds,
+VisibilitySet shadow_map_visibility(Span<const TriMesh* const> occluders, const Bbox3d& scene_bounds,
                                     const Receivers& receivers, Span<const Vec3d> samples_ws, const AreaLight& light,
                                     const ShadowOptions& options);
 
@@ -114,7 +114,7 @@ CameraSpec default_shadow_camera(const AreaLight& light, const Bbox3d& bounds, i
 /// \throw InvalidInput if the light emits toward none of the scene's bounding-box corners ("the light
 ///        faces away from the scene"), for options outside their ranges, or if a reconstruction
 ///        method yields an empty mesh set.
-ShadowResult render_shadows(const mesh::TriMesh& mesh, const SampledScene& scene, const Receivers& receivers,
+ShadowResult render_shadows(const TriMesh& mesh, const SampledScene& scene, const Receivers& receivers,
                             const AreaLight& light, ShadowMethod method, const ShadowOptions& options = {});
 
 }  // namespace raysift::nrr

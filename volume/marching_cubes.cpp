@@ -505,7 +505,7 @@ void link_neighbour_vertices(const IsoContext& ctx, std::size_t b, const std::ui
 
 /// Pass 3 for one block: vertices, then triangles in cell order (x, y, z) and table order.
 void fill_block(const IsoContext& ctx, std::size_t b, const IndexToWorld& to_world, const CaseTable& corners,
-                mesh::TriMesh& mesh) {
+                TriMesh& mesh) {
   if (ctx.counts[b].vertices == 0 && ctx.counts[b].triangles == 0) return;
   std::uint32_t rows[kR * kR];
   block_rows(ctx, b, rows);
@@ -551,7 +551,7 @@ bool for_each_block(std::size_t n, const MarchingCubesOptions& options, double b
 }
 
 /// One surface; `progress_begin/end` is this iso-value's share of the whole call's progress.
-mesh::TriMesh extract(const openvdb::FloatGrid& grid, const BlockSet& blocks, double iso,
+TriMesh extract(const openvdb::FloatGrid& grid, const BlockSet& blocks, double iso,
                       const MarchingCubesOptions& options, double progress_begin, double progress_end) {
   float iso_f = float(iso);
   if (double(iso_f) < iso) iso_f = std::nextafter(iso_f, std::numeric_limits<float>::infinity());
@@ -577,7 +577,7 @@ mesh::TriMesh extract(const openvdb::FloatGrid& grid, const BlockSet& blocks, do
     ctx.triangle_offset[b + 1] = ctx.triangle_offset[b] + ctx.counts[b].triangles;
   }
   if (ctx.vertex_offset[n] > UINT32_MAX) throw InvalidInput("marching cubes: more than 2^32 vertices");
-  mesh::TriMesh mesh;
+  TriMesh mesh;
   // The zero-filling (and first-touch page faults) of the two arrays costs as much as a pass: overlap them.
   auto size_positions = [&] { mesh.positions.resize(ctx.vertex_offset[n]); };
   auto size_triangles = [&] { mesh.triangles.resize(ctx.triangle_offset[n]); };
@@ -598,7 +598,7 @@ mesh::TriMesh extract(const openvdb::FloatGrid& grid, const BlockSet& blocks, do
 
 }  // namespace
 
-std::vector<mesh::TriMesh> extract_isosurfaces(const Volume& volume, Span<const double> iso_values,
+std::vector<TriMesh> extract_isosurfaces(const Volume& volume, Span<const double> iso_values,
                                                const MarchingCubesOptions& options) {
   for (const double iso : iso_values)
     if (!std::isfinite(iso)) throw InvalidInput("marching cubes: iso-value must be finite, got " + std::to_string(iso));
@@ -606,7 +606,7 @@ std::vector<mesh::TriMesh> extract_isosurfaces(const Volume& volume, Span<const 
     throw InvalidInput("marching cubes: volume '" + volume.name() + "' has no active voxels; nothing to mesh");
   const openvdb::FloatGrid& grid = *volume.impl().grid;
   const BlockSet blocks = collect_blocks(grid.tree(), options.threaded);
-  std::vector<mesh::TriMesh> meshes(iso_values.size());
+  std::vector<TriMesh> meshes(iso_values.size());
   const double share = 1.0 / double(std::max<std::size_t>(1, iso_values.size()));
   for (std::size_t i = 0; i < iso_values.size(); ++i) {
     if (options.cancel && options.cancel->load()) break;
@@ -615,7 +615,7 @@ std::vector<mesh::TriMesh> extract_isosurfaces(const Volume& volume, Span<const 
   return meshes;
 }
 
-mesh::TriMesh extract_isosurface(const Volume& volume, double iso, const MarchingCubesOptions& options) {
+TriMesh extract_isosurface(const Volume& volume, double iso, const MarchingCubesOptions& options) {
   const double isos[1] = {iso};
   return std::move(extract_isosurfaces(volume, Span<const double>(isos, 1), options).front());
 }

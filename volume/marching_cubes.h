@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "core/span.h"
-#include "mesh/tri_mesh.h"
+#include "core/tri_mesh.h"
 #include "volume/volume.h"
 
 namespace raysift::volume {
@@ -38,11 +38,11 @@ struct MarchingCubesOptions {
 /// closed, consistently oriented 2-manifold. NaN voxels count as outside.
 /// \param iso the iso-value, finite. An iso-value outside the data range yields an empty mesh.
 /// \throw InvalidInput if iso is not finite or the volume has no active voxels.
-mesh::TriMesh extract_isosurface(const Volume& volume, double iso, const MarchingCubesOptions& options = {});
+TriMesh extract_isosurface(const Volume& volume, double iso, const MarchingCubesOptions& options = {});
 
 /// One surface per iso-value, in the given order; each is extracted on its own (separate meshes).
 /// \throw InvalidInput as extract_isosurface().
-std::vector<mesh::TriMesh> extract_isosurfaces(const Volume& volume, Span<const double> iso_values,
+std::vector<TriMesh> extract_isosurfaces(const Volume& volume, Span<const double> iso_values,
                                                const MarchingCubesOptions& options = {});
 
 }  // namespace raysift::volume

@@ -44,7 +44,7 @@ std::string str(double v) {
 
 /// [choice] Default view: from +z towards the bbox centre, up +y, fov_y 30 degrees, at the distance where
 /// the bounding sphere (half the bbox diagonal) fits the narrower field of view with a 10 % margin.
-CameraSpec fit_camera(const mesh::TriMesh& mesh, int width, int height) {
+CameraSpec fit_camera(const TriMesh& mesh, int width, int height) {
   Bbox3d box;
   for (const Vec3f& p : mesh.positions) box.expand(Vec3d(p));
   CameraSpec c;
@@ -182,7 +182,7 @@ RegisterCommand reg(
           camera = camera_spec_from_json(read_json_file(opt->camera_path), opt->camera_path);
 
         Timer timer;
-        const mesh::TriMesh mesh = mesh::read_mesh(mesh_path);
+        const TriMesh mesh = mesh::read_mesh(mesh_path);
         const double read_ms = timer.elapsed_ms();
         CameraSpec spec = camera ? *camera : fit_camera(mesh, 800, 600);
         if (opt->width > 0) spec.width = opt->width;

@@ -120,7 +120,7 @@ isosurface::PipelineOptions pipeline_options(const MeshCliOptions& o) {
   return p;
 }
 
-Json surface_json(const mesh::TriMesh& m) {
+Json surface_json(const TriMesh& m) {
   if (m.empty()) return {{"triangles", 0}, {"vertices", 0}, {"watertight", false}, {"euler_characteristic", 0}, {"area", 0.0}};
   const mesh::MeshAnalysis a = mesh::analyze_mesh(m);
   Json s = {{"triangles", a.faces},
@@ -169,7 +169,7 @@ void run(const MeshCliOptions& o, const CommonOptions& common, CLI::App& sub) {
     surface_stats.push_back(surface_json(s.mesh));
   }
   if (common.verbose) std::cerr << echo_command(o, iso_values, common) << "\n";
-  const mesh::TriMesh combined = isosurface::merge_surfaces(set);
+  const TriMesh combined = isosurface::merge_surfaces(set);
   if (combined.empty())
     throw InvalidInput(file_message(input.volume_path, "no iso-surface found at the chosen iso-values; nothing written"));
   mesh::write_mesh(o.out, combined);

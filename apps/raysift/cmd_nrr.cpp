@@ -149,7 +149,7 @@ RegisterCommand reg(
                            " views; see --help (or pass --no-metrics)");
 
         Timer load_timer;
-        const mesh::TriMesh mesh = mesh::read_mesh(o.mesh);
+        const TriMesh mesh = mesh::read_mesh(o.mesh);
         const nrr::SampledScene scene(mesh);
         const double load_ms = load_timer.elapsed_ms();
 

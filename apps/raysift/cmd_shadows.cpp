@@ -145,7 +145,7 @@ RegisterCommand reg(
         if (file_extension(opt->input) == ".json") scene_path = opt->input;
         if (!scene_path.empty()) scene = load_scene(scene_path);
         Timer total;
-        mesh::TriMesh mesh;
+        TriMesh mesh;
         std::optional<CameraSpec> builtin_camera;
         if (file_extension(opt->input) == ".json") {
           if (scene.mesh.empty()) throw InvalidInput(file_message(scene_path, "the scene has no 'mesh' key"));

@@ -3,7 +3,7 @@
 /// optimal vertex placement. Internal to mesh/: decimate() is the public entry (docs/isosurface.md, Decimation).
 #include <cstddef>
 
-#include "mesh/tri_mesh.h"
+#include "core/tri_mesh.h"
 
 namespace raysift::mesh::detail {
 

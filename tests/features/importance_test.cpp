@@ -97,7 +97,7 @@ class SphereImportance : public ::testing::Test {
     mesh_ = mesh::make_icosphere(1.0, 4);
     curvature_ = mesh::compute_curvature(mesh_);
   }
-  mesh::TriMesh mesh_;
+  TriMesh mesh_;
   mesh::MeshCurvature curvature_;
 };
 
@@ -176,7 +176,7 @@ TEST_F(SphereImportance, DisabledClassesProduceNothing) {
 }
 
 TEST_F(SphereImportance, SerialAndThreadedBuffersAreIdentical) {
-  const mesh::TriMesh torus = mesh::make_torus(3.0, 1.0, 96, 48);
+  const TriMesh torus = mesh::make_torus(3.0, 1.0, 96, 48);
   const mesh::MeshCurvature c = mesh::compute_curvature(torus);
   CameraSpec spec = front_camera(12.0, 320, 200);
   spec.eye = {0, -8, 9};
@@ -254,7 +254,7 @@ TEST(Importance, RejectsBadOptions) {
 TEST(Importance, StanfordBunnyWithHolesRuns) {
   const std::string path = RAYSIFT_SOURCE_DIR "/../shared/datasets/stanford_bunny_bun_zipper_35947v_69451tri.ply";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "dataset not found: " << path;
-  const mesh::TriMesh bunny = mesh::read_mesh(path);
+  const TriMesh bunny = mesh::read_mesh(path);
   const mesh::MeshCurvature c = mesh::compute_curvature(bunny);
   EXPECT_GT(c.boundary_vertices, 0u);  // bun_zipper has holes in its base
   Bbox3d box;

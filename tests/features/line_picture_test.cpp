@@ -29,7 +29,7 @@ std::size_t occurrences(const std::string& text, const std::string& what) {
 }
 
 TEST(LinePicture, LinesInClassColourOverGreyMeshOnWhite) {
-  const mesh::TriMesh plane = mesh::make_plane(2.0, 2);
+  const TriMesh plane = mesh::make_plane(2.0, 2);
   const Camera cam(front(128));
   const DepthBuffer depth = rasterize_depth(plane, cam);
   FeatureLines lines;

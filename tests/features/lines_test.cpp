@@ -39,7 +39,7 @@ double projected_length(const FeatureLines& lines, LineClass c, const Camera& ca
 class SphereLines : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    mesh_ = new mesh::TriMesh(mesh::make_icosphere(kRadius, 5));
+    mesh_ = new TriMesh(mesh::make_icosphere(kRadius, 5));
     curvature_ = new mesh::MeshCurvature(mesh::compute_curvature(*mesh_));
   }
   static void TearDownTestSuite() {
@@ -48,10 +48,10 @@ class SphereLines : public ::testing::Test {
   }
   static constexpr double kRadius = 1.0;
   static constexpr double kDistance = 5.0;
-  static mesh::TriMesh* mesh_;
+  static TriMesh* mesh_;
   static mesh::MeshCurvature* curvature_;
 };
-mesh::TriMesh* SphereLines::mesh_ = nullptr;
+TriMesh* SphereLines::mesh_ = nullptr;
 mesh::MeshCurvature* SphereLines::curvature_ = nullptr;
 
 TEST_F(SphereLines, ContourIsTheAnalyticCircle) {
@@ -97,7 +97,7 @@ TEST_F(SphereLines, NoSuggestiveContoursHighlightsRidgesOrValleys) {
 }
 
 TEST(Lines, PlaneHasNoLinesOfAnyKind) {
-  const mesh::TriMesh plane = mesh::make_plane(2.0, 40);
+  const TriMesh plane = mesh::make_plane(2.0, 40);
   const mesh::MeshCurvature c = mesh::compute_curvature(plane);
   for (const Vec3d& eye : {Vec3d{0, 0, 3}, Vec3d{2, 1, 0.5}, Vec3d{0.3, 0.2, 1}}) {
     LineOptions o;
@@ -109,7 +109,7 @@ TEST(Lines, PlaneHasNoLinesOfAnyKind) {
 class TorusLines : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    mesh_ = new mesh::TriMesh(mesh::make_torus(kMajor, kMinor, 160, 64));
+    mesh_ = new TriMesh(mesh::make_torus(kMajor, kMinor, 160, 64));
     curvature_ = new mesh::MeshCurvature(mesh::compute_curvature(*mesh_));
   }
   static void TearDownTestSuite() {
@@ -123,10 +123,10 @@ class TorusLines : public ::testing::Test {
     return camera_at({0, -d * std::sin(tilt), d * std::cos(tilt)}, 400, {0, 0, 1});
   }
   static constexpr double kMajor = 3.0, kMinor = 1.0;
-  static mesh::TriMesh* mesh_;
+  static TriMesh* mesh_;
   static mesh::MeshCurvature* curvature_;
 };
-mesh::TriMesh* TorusLines::mesh_ = nullptr;
+TriMesh* TorusLines::mesh_ = nullptr;
 mesh::MeshCurvature* TorusLines::curvature_ = nullptr;
 
 TEST_F(TorusLines, SuggestiveContoursLieOnTheInnerSide) {
@@ -193,7 +193,7 @@ TEST_F(TorusLines, SerialAndThreadedExtractionAreIdentical) {
 TEST(Lines, FacesAtNonManifoldVerticesAreSkipped) {
   // Two spheres touching at one shared vertex (mirror images across the plane through it): that vertex
   // has two separate face fans.
-  mesh::TriMesh m = mesh::make_icosphere(1.0, 3);
+  TriMesh m = mesh::make_icosphere(1.0, 3);
   const auto n = std::uint32_t(m.vertex_count());
   std::uint32_t touch = 0;
   for (std::uint32_t v = 0; v < n; ++v)
@@ -232,7 +232,7 @@ TEST(Lines, ParsesClassNamesAndRejectsUnknownOnes) {
 }
 
 TEST(Lines, RejectsMismatchedCurvatureNonFiniteEyeAndBadOptions) {
-  const mesh::TriMesh a = mesh::make_icosphere(1.0, 1), b = mesh::make_icosphere(1.0, 2);
+  const TriMesh a = mesh::make_icosphere(1.0, 1), b = mesh::make_icosphere(1.0, 2);
   const mesh::MeshCurvature ca = mesh::compute_curvature(a);
   EXPECT_THROW(extract_lines(b, ca, {0, 0, 5}), InvalidInput);
   EXPECT_THROW(extract_lines(a, ca, {0, NAN, 5}), InvalidInput);
@@ -249,7 +249,7 @@ TEST(Lines, RejectsMismatchedCurvatureNonFiniteEyeAndBadOptions) {
 }
 
 TEST(Lines, AllZeroAreaFacesGiveNoLinesAndNoError) {
-  mesh::TriMesh flat;
+  TriMesh flat;
   flat.positions = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0}};
   flat.triangles = {{0, 1, 2}, {1, 2, 3}};  // collinear: zero area
   const mesh::MeshCurvature c = mesh::compute_curvature(flat);

@@ -22,7 +22,7 @@ CameraSpec camera(const Vec3d& eye, const Vec3d& target, int w = 64, int h = 48)
 }
 
 TEST(Raster, TiltedPlaneDepthIsPerspectiveCorrect) {
-  mesh::TriMesh plane = mesh::make_plane(20.0, 3);
+  TriMesh plane = mesh::make_plane(20.0, 3);
   // Tilt the plane about the x axis by 40 degrees so the depth varies across the image.
   const double a = 40.0 * M_PI / 180.0;
   for (Vec3f& p : plane.positions) p = Vec3f(Vec3d(p.x, p.y * std::cos(a), p.y * std::sin(a)));
@@ -40,7 +40,7 @@ TEST(Raster, TiltedPlaneDepthIsPerspectiveCorrect) {
 }
 
 TEST(Raster, NearerTriangleWinsWhateverTheOrder) {
-  mesh::TriMesh m;
+  TriMesh m;
   m.positions = {{-5, -5, 0}, {5, -5, 0}, {0, 5, 0}, {-5, -5, 1}, {5, -5, 1}, {0, 5, 1}};
   m.triangles = {{3, 4, 5}, {0, 1, 2}};
   const Camera cam(camera({0, 0, 6}, {0, 0, 0}));
@@ -56,7 +56,7 @@ TEST(Raster, NearerTriangleWinsWhateverTheOrder) {
 // Triangles are set up and binned per chunk of faces and drawn per band of rows, in parallel: the buffer
 // must not depend on the split (a mesh of many chunks, spanning many bands).
 TEST(Raster, SerialAndThreadedBuffersAreIdentical) {
-  const mesh::TriMesh sphere = mesh::make_icosphere(1.0, 6);  // 81920 faces: ten chunks
+  const TriMesh sphere = mesh::make_icosphere(1.0, 6);  // 81920 faces: ten chunks
   const Camera cam(camera({0.3, 0.4, 3.0}, {0, 0, 0}, 97, 131));
   const DepthBuffer serial = rasterize_depth(sphere, cam, {false});
   const DepthBuffer threaded = rasterize_depth(sphere, cam, {true});
@@ -68,7 +68,7 @@ TEST(Raster, SerialAndThreadedBuffersAreIdentical) {
 }
 
 TEST(Raster, CameraInsideASphereSeesItEverywhere) {
-  const mesh::TriMesh sphere = mesh::make_icosphere(1.0, 3);
+  const TriMesh sphere = mesh::make_icosphere(1.0, 3);
   const Camera cam(camera({0.2, 0.1, 0.3}, {1, 0.5, -1}));
   const DepthBuffer d = rasterize_depth(sphere, cam);
   for (std::uint32_t f : d.face.pixels) EXPECT_NE(f, kNoFace);
@@ -80,9 +80,9 @@ TEST(Raster, CameraInsideASphereSeesItEverywhere) {
 
 TEST(Raster, EmptyMeshIsAllBackgroundAndBadInputThrows) {
   const Camera cam(camera({0, 0, 5}, {0, 0, 0}));
-  const DepthBuffer d = rasterize_depth(mesh::TriMesh{}, cam);
+  const DepthBuffer d = rasterize_depth(TriMesh{}, cam);
   for (float z : d.depth.pixels) EXPECT_EQ(z, std::numeric_limits<float>::infinity());
-  mesh::TriMesh bad = mesh::make_icosphere(1.0, 1);
+  TriMesh bad = mesh::make_icosphere(1.0, 1);
   bad.positions[2].x = std::numeric_limits<float>::infinity();
   EXPECT_THROW(rasterize_depth(bad, cam), InvalidInput);
   bad = mesh::make_icosphere(1.0, 1);

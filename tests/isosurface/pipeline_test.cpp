@@ -96,7 +96,7 @@ TEST(Pipeline, IdenticalForOneAndTwoThreads) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
     return merge_surfaces(build_isosurfaces(shells(), nullptr, o));
   };
-  const mesh::TriMesh one = run(1), two = run(2);
+  const TriMesh one = run(1), two = run(2);
   EXPECT_EQ(one.triangles, two.triangles);
   ASSERT_EQ(one.positions.size(), two.positions.size());
   for (std::size_t i = 0; i < one.positions.size(); ++i)

@@ -51,7 +51,7 @@ double pixel_area(const CameraSpec& spec, double depth) {
   return side * side;
 }
 
-double mesh_area(const mesh::TriMesh& m) {
+double mesh_area(const TriMesh& m) {
   double area = 0;
   for (const auto& t : m.triangles) {
     const Vec3d a(m.positions[t[0]]), b(m.positions[t[1]]), c(m.positions[t[2]]);
@@ -61,7 +61,7 @@ double mesh_area(const mesh::TriMesh& m) {
 }
 
 // Number of triangles using each undirected edge.
-std::map<std::pair<std::uint32_t, std::uint32_t>, int> edge_use(const mesh::TriMesh& m) {
+std::map<std::pair<std::uint32_t, std::uint32_t>, int> edge_use(const TriMesh& m) {
   std::map<std::pair<std::uint32_t, std::uint32_t>, int> use;
   for (const auto& t : m.triangles)
     for (int k = 0; k < 3; ++k) ++use[{std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])}];
@@ -129,7 +129,7 @@ TEST(Reconstruction, DoesNotBridgeDepthDiscontinuity) {
   const CameraSpec spec = test_camera();
   const DepthImage image = plane_image(spec, 0.5, all, step);
   const DepthImage corners = plane_image(corner_camera(spec), 0.0, all, step);
-  auto spans_step = [](const mesh::TriMesh& m) {
+  auto spans_step = [](const TriMesh& m) {
     for (const auto& t : m.triangles) {
       bool near = false, far = false;
       for (auto v : t) (m.positions[v].z > -kDepth * 1.01 ? near : far) = true;

@@ -121,7 +121,7 @@ INSTANTIATE_TEST_SUITE_P(Sampler, NrrModes,
                          [](const auto& info) { return info.param == SamplingMode::NrrPixel ? "Pixel" : "Visibility"; });
 
 TEST(Sampler, ConvexMeshLaterImagesHoldOnlyWhatEarlierEyesCannotSee) {
-  const mesh::TriMesh sphere = mesh::make_icosphere(1.0, 2);
+  const TriMesh sphere = mesh::make_icosphere(1.0, 2);
   const SampledScene scene(sphere);
   // Wide views: the whole sphere is inside every frustum, so visibility is decided by facing alone.
   const std::vector<CameraSpec> views = {camera({0, 0, 4}, {}, 60, 128), camera({3, 0, 2}, {}, 60, 128),
@@ -160,8 +160,8 @@ TEST(Sampler, ConvexMeshLaterImagesHoldOnlyWhatEarlierEyesCannotSee) {
 }
 
 /// Five parallel quads z = 0..4 facing +z; the camera above looks down, slightly off the diagonals.
-mesh::TriMesh quad_stack() {
-  mesh::TriMesh m;
+TriMesh quad_stack() {
+  TriMesh m;
   for (int k = 0; k < 5; ++k) {
     const auto b = std::uint32_t(m.positions.size());
     const float z = float(k);
@@ -223,7 +223,7 @@ TEST(Sampler, BadInputThrows) {
   std::vector<CameraSpec> huge = {camera({0, 0, 5}, {}, 40, 8)};
   huge[0].width = kMaxImageSide + 1;
   EXPECT_THROW(render_depth_images(scene, Span<const CameraSpec>(huge)), InvalidInput);
-  EXPECT_THROW(SampledScene(mesh::TriMesh{}), InvalidInput);
+  EXPECT_THROW(SampledScene(TriMesh{}), InvalidInput);
   EXPECT_THROW(parse_sampling_mode("nrr"), InvalidInput);
 }
 

@@ -17,16 +17,16 @@ namespace raysift::nrr {
 namespace {
 
 // Square in the plane z = height, centred at (cx, cy), side `side`, normal +z.
-mesh::TriMesh square(double cx, double cy, double height, double side) {
+TriMesh square(double cx, double cy, double height, double side) {
   const float h = float(side / 2);
-  mesh::TriMesh m;
+  TriMesh m;
   m.positions = {Vec3f{float(cx) - h, float(cy) - h, float(height)}, Vec3f{float(cx) + h, float(cy) - h, float(height)},
                  Vec3f{float(cx) + h, float(cy) + h, float(height)}, Vec3f{float(cx) - h, float(cy) + h, float(height)}};
   m.triangles = {{0, 1, 2}, {0, 2, 3}};
   return m;
 }
 
-mesh::TriMesh merged(mesh::TriMesh a, const mesh::TriMesh& b) {
+TriMesh merged(TriMesh a, const TriMesh& b) {
   const auto offset = std::uint32_t(a.positions.size());
   a.positions.insert(a.positions.end(), b.positions.begin(), b.positions.end());
   for (auto t : b.triangles) a.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
@@ -37,7 +37,7 @@ mesh::TriMesh merged(mesh::TriMesh a, const mesh::TriMesh& b) {
 // edge_v = -z); occluder of side b at height h centred at (ox, oy); receivers on a grid on z = 0.
 struct Penumbra {
   double a = 2.0, big_h = 4.0, b = 1.0, h = 1.5, ox = 0.3, oy = -0.2;
-  mesh::TriMesh mesh = merged(square(ox, oy, h, b), square(0, 0, 0, 12.0));
+  TriMesh mesh = merged(square(ox, oy, h, b), square(0, 0, 0, 12.0));
   SampledScene scene{mesh};
   AreaLight light{{0, 0, big_h}, {a, 0, 0}, {0, -a, 0}};
 
@@ -244,7 +244,7 @@ TEST(SoftShadows, NrrBeatsConventionalOnBlocks4AndGrass) {
 // the depth images from the light see only back faces (culled), so the depth-image methods report an
 // empty reconstruction instead of inventing shadows.
 TEST(SoftShadows, LightInsideGeometry) {
-  const mesh::TriMesh sphere = mesh::make_icosphere(1.0, 2);
+  const TriMesh sphere = mesh::make_icosphere(1.0, 2);
   const SampledScene scene(sphere);
   CameraSpec cam;
   cam.eye = {0, 0, 4};

@@ -148,7 +148,7 @@ TEST(Scenes, GrassAndUrbanHitTheirTriangleTargetsAndDependOnlyOnTheSeed) {
 TEST(Scenes, GrassBladesAreTwoSided) {
   SceneOptions o;
   o.triangles = 102;
-  const mesh::TriMesh m = make_scene(SceneKind::Grass, o).mesh;
+  const TriMesh m = make_scene(SceneKind::Grass, o).mesh;
   // After the ground, each blade is 5 front triangles then their 5 reversed back copies.
   for (std::size_t blade = 0; blade < 10; ++blade)
     for (std::size_t k = 0; k < 5; ++k) {

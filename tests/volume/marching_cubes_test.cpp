@@ -24,7 +24,6 @@ namespace {
 
 using mesh::analyze_mesh;
 using mesh::MeshAnalysis;
-using mesh::TriMesh;
 constexpr double kPi = 3.14159265358979323846;
 
 double min_triangle_area(const TriMesh& m) {

@@ -1,14 +1,15 @@
 #pragma once
 /// \file The plain triangle mesh passed between modules: float positions (world space) and uint32
 /// triangles, counter-clockwise when seen from outside (normals = (p1-p0)x(p2-p0) point outward).
-/// OpenMesh stays inside mesh/; this struct is the contract.
+/// It lives in core because volume/ (marching cubes) produces it and mesh/ consumes it; OpenMesh stays inside
+/// mesh/, this struct is the contract.
 #include <array>
 #include <cstdint>
 #include <vector>
 
 #include "core/vec.h"
 
-namespace raysift::mesh {
+namespace raysift {
 
 struct TriMesh {
   std::vector<Vec3f> positions;                     ///< world space
@@ -19,4 +20,4 @@ struct TriMesh {
   bool empty() const { return triangles.empty(); }
 };
 
-}  // namespace raysift::mesh
+}  // namespace raysift
