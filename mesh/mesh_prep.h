@@ -12,7 +12,7 @@ namespace raysift::mesh {
 
 struct MeshPrepOptions {
   SmoothingOptions smooth_before;  ///< default 10 iterations (ALGORITHMS.md: 10-50 before decimating)
-  DecimationOptions decimation;    ///< default ratio 0.1
+  DecimationOptions decimation;    ///< default ratio 0.1; refine_distance is switched off when smooth_after runs
   SmoothingOptions smooth_after;   ///< default 10 iterations
 };
 
