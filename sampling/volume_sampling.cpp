@@ -14,16 +14,10 @@ namespace raysift::sampling {
 
 namespace {
 
-/// True when the TF's opacity stays at or below the iso choice's threshold at every value the volume holds (the
-/// ends of its range and the control points inside it bound the piecewise-linear opacity), i.e. when
-/// volume::select_iso_values would find no surface.
+/// True when volume::select_iso_values would find no surface (the TF hides every value the volume holds).
 bool transparent_over_data(const volume::Volume& volume, const volume::TransferFunction& tf) {
-  const double threshold = volume::IsoValueOptions{}.min_opacity;
   const volume::GridInfo info = volume.info();
-  if (tf.opacity(info.value_min) > threshold || tf.opacity(info.value_max) > threshold) return false;
-  for (const volume::TfPoint& p : tf.points())
-    if (p.x > info.value_min && p.x < info.value_max && p.a > threshold) return false;
-  return true;
+  return volume::max_tf_opacity(tf, info.value_min, info.value_max).opacity <= volume::IsoValueOptions{}.min_opacity;
 }
 
 /// The feature geometry a request asks for: the prepared mesh file, or built for the caster's view.

@@ -69,6 +69,17 @@ std::vector<Peak> local_maxima(const std::vector<double>& y) {
 
 }  // namespace
 
+TfOpacityMax max_tf_opacity(const TransferFunction& tf, double lo, double hi) {
+  TfOpacityMax best{lo, double(tf.opacity(lo))};
+  const auto probe = [&](double x) {
+    if (tf.opacity(x) > best.opacity) best = {x, double(tf.opacity(x))};
+  };
+  probe(hi);
+  for (const TfPoint& p : tf.points())
+    if (p.x > lo && p.x < hi) probe(p.x);
+  return best;
+}
+
 std::vector<IsoValue> select_iso_values(const Histogram& histogram, const TransferFunction& tf,
                                         const IsoValueOptions& options) {
   if (options.max_surfaces < 1)
@@ -81,18 +92,8 @@ std::vector<IsoValue> select_iso_values(const Histogram& histogram, const Transf
   const double lo = histogram.min, hi = histogram.max;
   const double width = histogram.bin_width();
 
-  // Highest TF opacity inside the data range: at bin centres, the range ends and control points inside it.
-  std::vector<double> probes = {lo, hi};
-  for (std::size_t b = 0; b < histogram.counts.size(); ++b) probes.push_back(histogram.bin_center(b));
-  for (const TfPoint& p : tf.points())
-    if (p.x >= lo && p.x <= hi) probes.push_back(p.x);
-  double best_value = lo, best_opacity = -1;
-  for (const double x : probes)
-    if (tf.opacity(x) > best_opacity) {
-      best_opacity = tf.opacity(x);
-      best_value = x;
-    }
-  if (best_opacity <= options.min_opacity)
+  const TfOpacityMax most_opaque = max_tf_opacity(tf, lo, hi);
+  if (most_opaque.opacity <= options.min_opacity)
     throw InvalidInput(format("the transfer function's opacity is zero over the whole data range [%g, %g]: "
                               "no surface to extract; raise the opacity where the material is",
                               lo, hi));
@@ -122,8 +123,8 @@ std::vector<IsoValue> select_iso_values(const Histogram& histogram, const Transf
     candidates.push_back({value, format("TF opacity maximum %.3f", peak.height)});
   }
   if (candidates.empty())
-    candidates.push_back({best_value, format("highest TF opacity (%.3f) in the data range; no histogram peak is "
-                                             "visible and no TF opacity maximum lies in the range", best_opacity)});
+    candidates.push_back({most_opaque.value, format("highest TF opacity (%.3f) in the data range; no histogram peak is "
+                                             "visible and no TF opacity maximum lies in the range", most_opaque.opacity)});
 
   std::vector<IsoValue> chosen;
   const double merge_distance = options.merge_distance_bins * width;

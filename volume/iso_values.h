@@ -25,6 +25,17 @@ struct IsoValue {
   std::string reason;  ///< e.g. "histogram peak 1 of 4 (smoothed count 5123), TF opacity 0.40"
 };
 
+/// Where the TF is most opaque over the data range [lo, hi]. The range ends and the control points inside it
+/// bound the piecewise-linear opacity, so the maximum is exact; `value` is the first probe reaching it (lo, hi,
+/// then the control points in order). The one test of whether a TF shows anything of the data:
+/// select_iso_values() finds no surface when `opacity` <= min_opacity, and the sampled renders then skip their
+/// feature geometry.
+struct TfOpacityMax {
+  double value = 0;
+  double opacity = 0;
+};
+TfOpacityMax max_tf_opacity(const TransferFunction& tf, double lo, double hi);
+
 /// Candidates in priority order: histogram peaks by decreasing smoothed height (only where the TF opacity
 /// exceeds min_opacity), then TF opacity maxima inside the data range by decreasing opacity (a plateau counts
 /// at its centre; a maximum touching the first or last control point is an open-ended ramp, not a material,

@@ -101,6 +101,22 @@ TEST(IsoValues, FindsBothMaterialsOfAVolume) {
   EXPECT_NEAR(iso[1].value, 200.0, 0.4);
 }
 
+TEST(IsoValues, MaxTfOpacityIsExactOverTheRange) {
+  // A tent peaking at 100 (opacity 0.8) and a plateau of 0.5 over [150, 200].
+  const TransferFunction tf({{0, 0, 0, 0, 0}, {100, 1, 1, 1, 0.8f}, {120, 1, 1, 1, 0}, {150, 1, 1, 1, 0.5f},
+                             {200, 1, 1, 1, 0.5f}, {255, 1, 1, 1, 0}});
+  const TfOpacityMax all = max_tf_opacity(tf, 0, 255);
+  EXPECT_EQ(all.value, 100);
+  EXPECT_FLOAT_EQ(all.opacity, 0.8f);
+  const TfOpacityMax rising = max_tf_opacity(tf, 10, 60);  // inside the rising edge: the upper end
+  EXPECT_EQ(rising.value, 60);
+  EXPECT_NEAR(rising.opacity, 0.48, 1e-6);
+  const TfOpacityMax plateau = max_tf_opacity(tf, 130, 255);  // first control point of the plateau
+  EXPECT_EQ(plateau.value, 150);
+  EXPECT_FLOAT_EQ(plateau.opacity, 0.5f);
+  EXPECT_EQ(max_tf_opacity(tf, 120, 120).opacity, 0);  // a single value where the TF is transparent
+}
+
 TEST(IsoValues, BadOptionsThrow) {
   const Histogram h = bumps({{100, 5000}});
   IsoValueOptions o;
