@@ -15,6 +15,7 @@
 #include <set>
 
 #include "core/errors.h"
+#include "mesh/detail/distance_refine.h"
 #include "mesh/mesh_analysis.h"
 #include "mesh/primitives.h"
 
@@ -234,6 +235,26 @@ TEST(Decimation, DistanceRefinementLowersTheSampledMaximumAndKeepsTheFaces) {
   const double before = sampled_hausdorff(plain.mesh, torus), after = sampled_hausdorff(refined.mesh, torus);
   EXPECT_LT(after, before) << before << " -> " << after;  // 0.0534 -> 0.0484 when written
   expect_closed_with_euler(refined.mesh, 0);
+}
+
+TEST(DistanceRefinement, ReportsTheBruteForceMaximumAndKeepsLockedVertices) {
+  const TriMesh torus = make_torus(1.0, 0.3, 48, 16);
+  DecimationOptions o;
+  o.ratio = 0.1;
+  o.refine_distance = false;
+  const TriMesh plain = decimate(torus, o).mesh;
+  std::vector<char> locked(plain.vertex_count(), 0);
+  for (std::size_t v = 0; v < locked.size(); v += 3) locked[v] = 1;
+  TriMesh refined = plain;
+  const detail::TriangleGrid grid(torus);
+  const detail::RefineResult r = detail::refine_distance(grid, refined, locked);
+  // The reported maxima are the exact sampled ones (up to the final rounding of positions to float).
+  EXPECT_NEAR(r.before, sampled_hausdorff(plain, torus), 1e-6);
+  EXPECT_NEAR(r.after, sampled_hausdorff(refined, torus), 1e-6);
+  EXPECT_LT(r.after, r.before);
+  EXPECT_GT(r.moves, 0u);
+  EXPECT_EQ(refined.triangles, plain.triangles);
+  for (std::size_t v = 0; v < locked.size(); v += 3) ASSERT_EQ(refined.positions[v], plain.positions[v]) << v;
 }
 
 TEST(Decimation, KeepsEveryInputVertexWithinTheMaxError) {
