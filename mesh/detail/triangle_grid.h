@@ -30,7 +30,6 @@ class TriangleGrid {
   Hit nearest(const Vec3d& p, double cap = std::numeric_limits<double>::infinity()) const;
   /// The closest point of the surface to p.
   Vec3d closest_point(const Vec3d& p) const;
-  const TriMesh& surface() const { return surface_; }
 
  private:
   std::size_t cell_index(int x, int y, int z) const { return (std::size_t(z) * n_[1] + y) * n_[0] + x; }
