@@ -29,7 +29,7 @@ void bad_flag(const std::string& flag, const std::string& range, const std::stri
 int main(int argc, char** argv) {
   using namespace raysift;
   using namespace raysift::app;
-  CLI::App cli{"raysift: prioritized volume ray casting and non-redundant scene discretization"};
+  CLI::App cli{"raysift: prioritized volume ray casting and non-redundant scene discretization", "raysift"};
   cli.set_version_flag("--version", std::string("raysift ") + RAYSIFT_VERSION);
   cli.require_subcommand(0, 1);
   CommonOptions common;
