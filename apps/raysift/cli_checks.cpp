@@ -7,15 +7,17 @@
 
 namespace raysift::app {
 
-CLI::Validator number_in(double lo, double hi, End lo_end) {
+CLI::Validator number_in(double lo, double hi, End lo_end, End hi_end) {
   std::ostringstream range;
-  range << (lo_end == End::Open ? "(" : "[") << lo << ", " << hi << (std::isinf(hi) ? ")" : "]");
+  range << (lo_end == End::Open ? "(" : "[") << lo << ", " << hi
+        << (hi_end == End::Open || std::isinf(hi) ? ")" : "]");
   return CLI::Validator(
-      [lo, hi, lo_end, text = range.str()](std::string& value) -> std::string {
+      [lo, hi, lo_end, hi_end, text = range.str()](std::string& value) -> std::string {
         double v = 0;
         const bool parsed = CLI::detail::lexical_cast(value, v);
         const bool above = lo_end == End::Open ? v > lo : v >= lo;
-        if (parsed && std::isfinite(v) && above && v <= hi) return "";
+        const bool below = hi_end == End::Open ? v < hi : v <= hi;
+        if (parsed && std::isfinite(v) && above && below) return "";
         return "must be a number in " + text + ", got " + value;
       },
       "in " + range.str(), "number_in");

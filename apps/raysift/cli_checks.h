@@ -17,9 +17,9 @@ inline CLI::Range image_side() { return CLI::Range(1, kMaxImageSide); }
 /// Whether an interval end belongs to it.
 enum class End { Closed, Open };
 
-/// A number in [lo, hi] (or (lo, hi] with End::Open); NaN never passes, and hi = infinity means unbounded
-/// but finite. Applied to each entry of a list option.
-CLI::Validator number_in(double lo, double hi, End lo_end = End::Closed);
+/// A finite number in [lo, hi] (either end open on request); NaN never passes, and hi = INFINITY means
+/// unbounded. Applied to each entry of a list option.
+CLI::Validator number_in(double lo, double hi, End lo_end = End::Closed, End hi_end = End::Closed);
 
 /// A path ending in one of `extensions` (e.g. {".exr", ".png"}).
 CLI::Validator has_extension(const std::vector<std::string>& extensions);
