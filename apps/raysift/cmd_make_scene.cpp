@@ -25,12 +25,12 @@ std::string views_path_for(const std::string& mesh_path) {
 
 RegisterCommand reg(
     "make-scene",
-    "write a procedural scene for multi-view sampling (blocks4, grass, urban) and its views file\n"
-    "Examples:\n"
-    "  raysift make-scene blocks4 -o blocks4.ply      # also writes blocks4.views.json\n"
-    "  raysift make-scene grass --seed 3 --triangles 20002 -o grass.ply",
+    "write a procedural scene for multi-view sampling (blocks4, grass, urban) and its views file",
     [](CLI::App& sub, CommonOptions& common) -> RunFunction {
       auto opt = std::make_shared<MakeSceneCliOptions>();
+      sub.footer("Examples:\n"
+                 "  raysift make-scene blocks4 -o blocks4.ply      # also writes blocks4.views.json\n"
+                 "  raysift make-scene grass --seed 3 --triangles 20002 -o grass.ply\n");
       sub.add_option("KIND", opt->kind, "blocks4 | grass | urban")->required();
       sub.add_option("-o,--out", opt->out, "output mesh .ply/.obj/.off; the views go to <stem>.views.json")
           ->required();

@@ -93,13 +93,14 @@ Json image_json(const nrr::ImageMetrics& m) {
 
 RegisterCommand reg(
     "nrr",
-    "sample a mesh with multi-view depth images (conventional, non-redundant, depth peeling) and measure them\n"
-    "Examples:\n"
-    "  raysift make-scene blocks4 -o b4.ply && raysift nrr b4.ply --views b4.views.json --mode nrr-pixel -o out\n"
-    "  raysift nrr grass.ply --view-region triangle --eyes \"-2.5,2.5,7;2.5,2.5,7;0,4.5,6\" --target 0,0.3,0 \\\n"
-    "      --mode peel --resolution 512 --intermediate-views 200 --stats s.json",
+    "sample a mesh with multi-view depth images (conventional, non-redundant, depth peeling) and measure them",
     [](CLI::App& sub, CommonOptions& common) -> RunFunction {
       auto opt = std::make_shared<NrrCliOptions>();
+      sub.footer(
+          "Examples:\n"
+          "  raysift make-scene blocks4 -o b4.ply && raysift nrr b4.ply --views b4.views.json --mode nrr-pixel -o out\n"
+          "  raysift nrr grass.ply --view-region triangle --eyes \"-2.5,2.5,7;2.5,2.5,7;0,4.5,6\" --target 0,0.3,0 \\\n"
+          "      --mode peel --resolution 512 --intermediate-views 200 --stats s.json\n");
       sub.add_option("MESH", opt->mesh, "input mesh .ply/.obj/.off")->required();
       sub.add_option("--mode", opt->mode, "conventional | nrr-pixel | nrr-visibility | peel")->capture_default_str();
       sub.add_option("--views", opt->views_file,

@@ -8,6 +8,7 @@
 #include <memory>
 #include <sstream>
 
+#include "apps/raysift/cli_checks.h"
 #include "apps/raysift/command.h"
 #include "apps/raysift/sampling_flags.h"
 #include "apps/raysift/volume_input.h"
@@ -31,8 +32,8 @@ struct RenderCliOptions {
   int width = -1, height = -1;  ///< -1 = from the camera file / scene / 512
   double step = volume::RenderOptions{}.step_voxels;
   std::string shading = "none";
-  std::string background = "0,0,0";
-  std::string light_dir;  ///< "" = headlight
+  std::vector<double> background{0, 0, 0};  ///< linear R,G,B
+  std::vector<double> light_dir;            ///< X,Y,Z; empty = headlight
   double early_termination = volume::RenderOptions{}.early_termination;
   bool no_skip = false, jitter = false, tf_normalized = false;
   std::string pixel;  ///< "x,y": trace one pixel serially and print it
@@ -96,66 +97,20 @@ const std::map<std::string, ModeFunction>& modes() {
   return table;
 }
 
-std::string mode_names() {
-  std::string names;
-  for (const auto& [name, fn] : modes()) names += (names.empty() ? "" : "|") + name;
+std::vector<std::string> mode_list() {
+  std::vector<std::string> names;
+  for (const auto& [name, fn] : modes()) names.push_back(name);
   return names;
 }
 
-/// "a,b,c" -> three numbers (NaN for any malformed item, which every range check rejects).
-std::vector<double> parse_triple(const std::string& text) {
-  std::stringstream s(text);
-  std::string item;
-  std::vector<double> v;
-  while (std::getline(s, item, ',')) {
-    try {
-      std::size_t used = 0;
-      v.push_back(std::stod(item, &used));
-      if (used != item.size()) v.back() = NAN;
-    } catch (const std::exception&) {
-      v.push_back(NAN);
-    }
-  }
-  return v;
+Vec3d light_direction(const std::vector<double>& v) {
+  const Vec3d d{v[0], v[1], v[2]};
+  if (dot(d, d) == 0.0) bad_flag("--light-dir", "three comma-separated finite numbers, not all zero (X,Y,Z)", "0,0,0");
+  return d;
 }
 
-Vec3f parse_background(const std::string& text) {
-  const std::vector<double> v = parse_triple(text);
-  if (v.size() != 3 || !std::all_of(v.begin(), v.end(), [](double c) { return c >= 0.0 && c <= 1.0; }))
-    bad_flag("--background", "three comma-separated linear values in [0,1] (R,G,B)", text);
-  return {float(v[0]), float(v[1]), float(v[2])};
-}
-
-Vec3d parse_light_dir(const std::string& text) {
-  const std::vector<double> v = parse_triple(text);
-  if (v.size() != 3 || !std::all_of(v.begin(), v.end(), [](double c) { return std::isfinite(c); }) ||
-      v[0] * v[0] + v[1] * v[1] + v[2] * v[2] == 0.0)
-    bad_flag("--light-dir", "three comma-separated finite numbers, not all zero (X,Y,Z)", text);
-  return {v[0], v[1], v[2]};
-}
-
-std::string num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
+/// The one rule CLI11's needs/excludes cannot state: it depends on the value of --mode.
 void validate(const RenderCliOptions& o) {
-  if (!modes().count(o.mode)) bad_flag("--mode", mode_names(), o.mode);
-  if (!(o.step > 0 && o.step <= 64)) bad_flag("--step", "in (0, 64] voxels", num(o.step));
-  if (!(o.early_termination > 0 && o.early_termination <= 1))
-    bad_flag("--early-termination", "in (0, 1]", num(o.early_termination));
-  if (o.width != -1 && (o.width < 1 || o.width > kMaxImageSide))
-    bad_flag("--width", "1.." + std::to_string(kMaxImageSide), std::to_string(o.width));
-  if (o.height != -1 && (o.height < 1 || o.height > kMaxImageSide))
-    bad_flag("--height", "1.." + std::to_string(kMaxImageSide), std::to_string(o.height));
-  if (o.shading != "none" && o.shading != "phong") bad_flag("--shading", "none|phong", o.shading);
-  const std::string ext = file_extension(o.out);
-  if (ext != ".exr" && ext != ".png") bad_flag("-o/--out", "a .exr or .png path", o.out);
-  if (!(o.ray_fraction > 0 && o.ray_fraction <= 1)) bad_flag("--ray-fraction", "in (0, 1]", num(o.ray_fraction));
-  if (!(o.budget_ms >= 0) || !std::isfinite(o.budget_ms)) bad_flag("--budget-ms", ">= 0 (0 = no budget)", num(o.budget_ms));
-  if (o.progressive < 0) bad_flag("--progressive", ">= 0 frames", std::to_string(o.progressive));
-  if (o.interpolation != "cubic" && o.interpolation != "linear") bad_flag("--interpolation", "linear|cubic", o.interpolation);
   if ((o.budget_ms > 0 || o.progressive > 0) && o.mode != "prioritized")
     throw UsageError("--budget-ms and --progressive need --mode prioritized; see --help");
 }
@@ -195,10 +150,10 @@ RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common
 
   in.options.step_voxels = o.step;
   in.options.shading = o.shading == "phong" ? volume::Shading::Phong : volume::Shading::None;
-  in.options.background = parse_background(o.background);
+  in.options.background = {float(o.background[0]), float(o.background[1]), float(o.background[2])};
   if (!o.light_dir.empty()) {
     in.options.phong.headlight = false;
-    in.options.phong.light_dir_ws = parse_light_dir(o.light_dir);
+    in.options.phong.light_dir_ws = light_direction(o.light_dir);
   }
   in.options.early_termination = o.early_termination;
   in.options.skip_empty_space = !o.no_skip;
@@ -227,6 +182,12 @@ RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common
   return in;
 }
 
+std::string join(const std::vector<double>& v) {
+  std::ostringstream s;
+  for (std::size_t i = 0; i < v.size(); ++i) s << (i ? "," : "") << v[i];
+  return s.str();
+}
+
 /// The effective options as a command line that reproduces the render (verbose mode).
 std::string echo_command(const RenderCliOptions& o, const RenderInputs& in, const CommonOptions& common) {
   std::ostringstream s;
@@ -234,7 +195,8 @@ std::string echo_command(const RenderCliOptions& o, const RenderInputs& in, cons
   if (!o.tf.empty()) s << " --tf " << o.tf;
   if (!o.camera.empty()) s << " --camera " << o.camera;
   s << " --width " << in.camera.width << " --height " << in.camera.height << " --mode " << o.mode << " --step "
-    << o.step << " --shading " << o.shading << (o.light_dir.empty() ? "" : " --light-dir " + o.light_dir) << " --background " << o.background << " --early-termination "
+    << o.step << " --shading " << o.shading << (o.light_dir.empty() ? "" : " --light-dir " + join(o.light_dir))
+    << " --background " << join(o.background) << " --early-termination "
     << o.early_termination << (o.no_skip ? " --no-skip" : "") << (o.jitter ? " --jitter" : "") << " --seed "
     << common.seed << " --threads " << common.threads << " -o " << o.out;
   return s.str();
@@ -259,19 +221,15 @@ void trace_one_pixel(const std::string& text, const volume::RayCaster& caster) {
 struct PathCliOptions {
   std::string camera_path;
   double target_fps = 0;
-  CLI::Option* target_fps_option = nullptr;  ///< to reject an explicit --target-fps 0
   bool compare_full = false;
   bool use_saliency = false;                 ///< "saliency" taken out of --features before the lines parse it
 };
 
 /// Checks the path flags and takes "saliency" out of --features (before build_inputs parses the classes).
 void prepare_path_flags(PathCliOptions& p, RenderCliOptions& o) {
-  if (p.target_fps_option->count() > 0 && !(std::isfinite(p.target_fps) && p.target_fps > 0))
-    bad_flag("--target-fps", "a number > 0 (frames per second)", std::to_string(p.target_fps));
   o.features = sampling::split_saliency_feature(o.features, p.use_saliency);
   if (p.camera_path.empty()) {
-    if (p.target_fps > 0 || p.use_saliency || p.compare_full)
-      throw UsageError("--target-fps, --reference/--compare-full and --features saliency need --camera-path; see --help");
+    if (p.use_saliency) throw UsageError("--features saliency needs --camera-path; see --help");
     return;
   }
   if (!sampling::is_frame_pattern(o.out))
@@ -306,29 +264,36 @@ RegisterCommand reg(
     [](CLI::App& sub, CommonOptions& common) -> RunFunction {
       auto opt = std::make_shared<RenderCliOptions>();
       sub.add_option("VOLUME", opt->volume, "input .vdb (default: the scene's volume)");
-      sub.add_option("-o,--out", opt->out, "output image: .exr (linear RGB + alpha = opacity) or .png (sRGB, opaque)")->required();
+      sub.add_option("-o,--out", opt->out, "output image: .exr (linear RGB + alpha = opacity) or .png (sRGB, opaque)")
+          ->required()->check(has_extension({".exr", ".png"}));
       sub.add_option("--grid", opt->grid, "grid name (default: the scene's, else the first float grid)");
       sub.add_option("--tf", opt->tf, "transfer function JSON (ParaView preset or {\"points\": ...})");
       sub.add_flag("--tf-normalized", opt->tf_normalized, "TF x values are 0..1 over the data range");
       sub.add_option("--camera", opt->camera, "camera JSON (default: the scene's, else fitted to the volume)");
-      sub.add_option("--width", opt->width, "image width in pixels, 1..16384 (default: camera's, else 512)");
-      sub.add_option("--height", opt->height, "image height in pixels, 1..16384 (default: camera's, else 512)");
-      sub.add_option("--mode", opt->mode, "render mode: " + mode_names())->capture_default_str();
-      sub.add_option("--step", opt->step, "sample distance in voxels, (0, 64]")->capture_default_str();
-      sub.add_option("--shading", opt->shading, "none|phong (Blinn-Phong, headlight)")->capture_default_str();
-      sub.add_option("--light-dir", opt->light_dir,
-                     "Phong: directional light travelling along X,Y,Z (world); default: headlight");
-      sub.add_option("--background", opt->background, "background R,G,B (linear, 0..1)")->capture_default_str();
-      sub.add_option("--early-termination", opt->early_termination, "stop a ray at this opacity; 1 disables")
+      sub.add_option("--width", opt->width, "image width in pixels (default: camera's, else " +
+                                                std::to_string(CameraSpec{}.width) + ")")->check(image_side());
+      sub.add_option("--height", opt->height, "image height in pixels (default: camera's, else " +
+                                                  std::to_string(CameraSpec{}.height) + ")")->check(image_side());
+      sub.add_option("--mode", opt->mode, "render mode")->check(CLI::IsMember(mode_list()))->capture_default_str();
+      sub.add_option("--step", opt->step, "sample distance in voxels")->check(number_in(0, 64, End::Open))
           ->capture_default_str();
+      sub.add_option("--shading", opt->shading, "none|phong (Blinn-Phong, headlight)")
+          ->check(CLI::IsMember({"none", "phong"}))->capture_default_str();
+      sub.add_option("--light-dir", opt->light_dir,
+                     "Phong: directional light travelling along X,Y,Z (world); default: headlight")
+          ->delimiter(',')->expected(3)->check(number_in(-INFINITY, INFINITY));
+      sub.add_option("--background", opt->background, "background R,G,B (linear)")->delimiter(',')->expected(3)
+          ->check(number_in(0, 1))->capture_default_str();
+      sub.add_option("--early-termination", opt->early_termination, "stop a ray at this opacity; 1 disables")
+          ->check(number_in(0, 1, End::Open))->capture_default_str();
       sub.add_flag("--no-skip", opt->no_skip, "disable empty-space skipping (same image, slower)");
       sub.add_flag("--jitter", opt->jitter, "random start offset per ray (from --seed)");
       sub.add_option("--pixel", opt->pixel, "debug: trace only pixel x,y serially and print it (no image written)");
       sub.add_option("--ray-fraction", opt->ray_fraction,
-                     "prioritized/subsample: rays as a fraction of the full render's, (0, 1]")
-          ->capture_default_str();
+                     "prioritized/subsample: rays as a fraction of the full render's")
+          ->check(number_in(0, 1, End::Open))->capture_default_str();
       sub.add_option("--budget-ms", opt->budget_ms, "prioritized: frame time budget in ms (0 = use --ray-fraction)")
-          ->capture_default_str();
+          ->check(number_in(0, INFINITY))->capture_default_str();
       sub.add_option("--features", opt->features,
                      "prioritized: line classes for the importance (contours,silhouettes,suggestive,highlights,"
                      "ridges,valleys|all) or none (pattern-only control)")
@@ -336,13 +301,13 @@ RegisterCommand reg(
       sub.add_option("--alpha", opt->alpha, "prioritized: " + alpha_flag_help());
       sub.add_option("--progressive", opt->progressive,
                      "prioritized: render N progressive frames of a still camera, write the last")
-          ->capture_default_str();
+          ->check(CLI::NonNegativeNumber)->capture_default_str();
       sub.add_option("--feature-mesh", opt->feature_mesh,
                      "prioritized: prepared feature mesh (e.g. from raysift mesh) instead of extracting iso-surfaces");
       sub.add_flag("--no-refine", opt->no_refine,
                    "prioritized: place rays by the a priori queue only (no contrast refinement from level 0)");
-      sub.add_option("--interpolation", opt->interpolation, "sampled modes: reconstruction rule, linear|cubic")
-          ->capture_default_str();
+      sub.add_option("--interpolation", opt->interpolation, "sampled modes: reconstruction rule")
+          ->check(CLI::IsMember({"linear", "cubic"}))->capture_default_str();
       sub.add_option("--feature-cache", opt->feature_cache,
                      "prioritized: directory caching the feature geometry across runs (keyed by volume, TF, options)");
       sub.footer(
@@ -353,13 +318,16 @@ RegisterCommand reg(
           "  raysift render --scene datasets/engine_ct_scene.json --mode prioritized --ray-fraction 0.2 -o p.exr\n"
           "  raysift render --scene datasets/engine_ct_scene.json --mode subsample --ray-fraction 0.2 -o s.exr");
       auto path = std::make_shared<PathCliOptions>();
-      sub.add_option("--camera-path", path->camera_path,
-                     "render a sequence: JSON list of cameras, {\"cameras\": [...]} or {\"orbit\": {centre, radius, "
-                     "elevation_deg, frames}}; -o is then a pattern such as frame_%03d.png; --features may add saliency");
-      path->target_fps_option = sub.add_option("--target-fps", path->target_fps,
-                                               "camera path, prioritized: adapt alpha00 to hold this frame rate (> 0)");
-      sub.add_flag("--reference,--compare-full", path->compare_full,
-                   "camera path: also render every frame fully (untimed) and report ssim_vs_full per frame");
+      auto* path_group = sub.add_option_group("Camera path");
+      CLI::Option* path_flag = path_group->add_option(
+          "--camera-path", path->camera_path,
+          "render a sequence: JSON list of cameras, {\"cameras\": [...]} or {\"orbit\": {centre, radius, "
+          "elevation_deg, frames}}; -o is then a pattern such as frame_%03d.png; --features may add saliency");
+      path_group->add_option("--target-fps", path->target_fps, "prioritized: adapt alpha00 to hold this frame rate")
+          ->check(number_in(0, INFINITY, End::Open))->needs(path_flag);
+      path_group->add_flag("--reference,--compare-full", path->compare_full,
+                           "also render every frame fully (untimed) and report ssim_vs_full per frame")
+          ->needs(path_flag);
       return [opt, path, &common] {
         const Timer total;
         prepare_path_flags(*path, *opt);
