@@ -18,7 +18,7 @@ CLI::Validator number_in(double lo, double hi, End lo_end, End hi_end) {
         const bool above = lo_end == End::Open ? v > lo : v >= lo;
         const bool below = hi_end == End::Open ? v < hi : v <= hi;
         if (parsed && std::isfinite(v) && above && below) return "";
-        return "must be a number in " + text + ", got " + value;
+        return "must be a number in " + text + ", got '" + value + "'";
       },
       "in " + range.str(), "number_in");
 }

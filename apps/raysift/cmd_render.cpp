@@ -11,6 +11,7 @@
 #include "apps/raysift/cli_checks.h"
 #include "apps/raysift/command.h"
 #include "apps/raysift/sampling_flags.h"
+#include "apps/raysift/sampling_stats.h"
 #include "apps/raysift/volume_input.h"
 #include "core/file_util.h"
 #include "core/image.h"
@@ -41,7 +42,7 @@ struct RenderCliOptions {
   double ray_fraction = sampling::SamplingOptions{}.ray_fraction;
   double budget_ms = 0;
   std::string features = "contours,silhouettes";
-  std::string alpha;            ///< "a00,a10,a01,a11,a20,a02"; empty = library default
+  std::vector<float> alpha;     ///< a00,a10,a01,a11,a20,a02; empty = library default
   int progressive = 0;
   std::string feature_mesh;
   std::string feature_cache;  ///< directory of the on-disk feature cache; empty = memory only
@@ -75,12 +76,11 @@ ModeOutput sampled_mode(const RenderInputs& in, const volume::RayCaster& caster,
   if (r.features_skipped && !common.quiet)
     std::cerr << "raysift: warning: the transfer function is transparent over the whole data range; no surface feeds "
                  "the feature lines, rendering without them\n";
-  if (r.budget_too_small && !common.quiet)
+  if (r.any_budget_too_small && !common.quiet)
     std::cerr << "raysift: warning: --budget-ms " << in.sampled.sampling.budget_ms
               << " is below the time of the level-0 pattern plus reconstruction; only level 0 was traced\n";
-  const auto rays = r.stats["rays_traced"].get<std::uint64_t>();
-  const auto samples = r.stats["samples"].get<std::uint64_t>();
-  return ModeOutput{std::move(r.image), rays, samples, std::move(r.stats)};
+  Json stats = sampled_render_json(r, in.sampled.sampling.budget_ms);
+  return ModeOutput{std::move(r.image), r.rays_traced, r.samples, std::move(stats)};
 }
 
 const std::map<std::string, ModeFunction>& modes() {
@@ -174,7 +174,7 @@ RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common
   });
   in.sampled.feature_cache = in.feature_cache.get();
   try {
-    if (!o.alpha.empty()) in.sampled.sampling.mapping = sampling::parse_priority_mapping(o.alpha);
+    if (!o.alpha.empty()) std::copy(o.alpha.begin(), o.alpha.end(), in.sampled.sampling.mapping.alpha.begin());
     in.sampled.features.classes = sampling::parse_feature_list(o.features);
   } catch (const InvalidInput& e) {
     throw UsageError(std::string(e.what()) + "; see --help");
@@ -227,7 +227,7 @@ struct PathCliOptions {
 
 /// Checks the path flags and takes "saliency" out of --features (before build_inputs parses the classes).
 void prepare_path_flags(PathCliOptions& p, RenderCliOptions& o) {
-  o.features = sampling::split_saliency_feature(o.features, p.use_saliency);
+  o.features = split_saliency_feature(o.features, p.use_saliency);
   if (p.camera_path.empty()) {
     if (p.use_saliency) throw UsageError("--features saliency needs --camera-path; see --help");
     return;
@@ -242,7 +242,6 @@ void prepare_path_flags(PathCliOptions& p, RenderCliOptions& o) {
 void render_path(const PathCliOptions& p, const RenderCliOptions& o, const RenderInputs& in, const CommonOptions& common) {
   sampling::PathRenderRequest request;
   request.camera_path = p.camera_path;
-  request.out_pattern = o.out;
   request.options.sampling = in.sampled.sampling;
   request.options.features.lines = in.sampled.features;
   request.options.features.use_saliency = p.use_saliency;
@@ -251,11 +250,21 @@ void render_path(const PathCliOptions& p, const RenderCliOptions& o, const Rende
   request.geometry = in.sampled.geometry;
   request.feature_mesh = in.sampled.feature_mesh;
   request.feature_cache = in.sampled.feature_cache;
-  Json stats = sampling::run_path_request(in.volume, *in.tf, in.options, in.camera, request);
+  const sampling::PathRenderResult r = sampling::run_path_request(
+      in.volume, *in.tf, in.options, in.camera, request, [&](const sampling::PathFrame& frame, const ImageRGBA& image) {
+        const std::string name = sampling::frame_file_name(o.out, frame.index);
+        if (file_extension(name) != ".png") return write_image(name, image);
+        ImageRGBA opaque = image;  // composited colour: show it opaque, as a single frame does
+        for (Rgba& px : opaque.pixels) px.a = 1.0f;
+        write_image(name, opaque);
+      });
+  Json stats = path_stats_json(r.frames, p.target_fps);
+  stats["camera_path"] = p.camera_path;
+  stats["frame_files"] = {sampling::frame_file_name(o.out, 0), sampling::frame_file_name(o.out, int(r.frames.size()) - 1)};
+  stats["times_ms"] = {{"features_setup", r.features_setup_ms}, {"total", r.total_ms}};
   stats["mode"] = o.mode;
   if (common.verbose)
-    std::cerr << "rendered " << stats.at("frames").size() << " frames to " << o.out << " in "
-              << stats.at("times_ms").at("total").get<double>() << " ms\n";
+    std::cerr << "rendered " << r.frames.size() << " frames to " << o.out << " in " << r.total_ms << " ms\n";
   write_stats_if_requested(common, stats);
 }
 
@@ -298,7 +307,7 @@ RegisterCommand reg(
                      "prioritized: line classes for the importance (contours,silhouettes,suggestive,highlights,"
                      "ridges,valleys|all) or none (pattern-only control)")
           ->capture_default_str();
-      sub.add_option("--alpha", opt->alpha, "prioritized: " + alpha_flag_help());
+      add_alpha_option(sub, opt->alpha, "prioritized: ");
       sub.add_option("--progressive", opt->progressive,
                      "prioritized: render N progressive frames of a still camera, write the last")
           ->check(CLI::NonNegativeNumber)->capture_default_str();
