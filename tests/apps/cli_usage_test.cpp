@@ -113,6 +113,22 @@ TEST(CliUsage, ShadowsValidatorsNameTheFlag) {
                                            });
 }
 
+TEST(CliUsage, NrrValidatorsNameTheFlag) {
+  const std::string n = "nrr b4.ply --view-region segment --eyes \"0,0,5;1,0,5\" --target 0,0,0 -o out ";
+  expect_usage_errors("cli_nrr_flags", {
+                                           {n + "--mode sideways", "--mode"},
+                                           {n + "--redundancy both", "--redundancy"},
+                                           {n + "--fov-y-deg 180", "--fov-y-deg"},
+                                           {n + "--intermediate-views 0", "--intermediate-views"},
+                                           {n + "--layers -1", "--layers"},
+                                           {n + "--target 1,2", "--target"},
+                                           {n + "--up 0,nan,0", "--up"},
+                                           {"nrr b4.ply --view-region disc --eyes 0,0,5 --target 0,0,0", "--view-region"},
+                                           {"nrr b4.ply --view-region segment --eyes \"0,0,5;1,0\" --target 0,0,0",
+                                            "--eyes"},
+                                       });
+}
+
 TEST(CliUsage, LinesInfoAndDemoValidatorsNameTheFlag) {
   const std::string l = "lines x.ply -o out.png ";
   expect_usage_errors("cli_lines_flags", {
