@@ -1,64 +1,23 @@
-// raysift render: volume ray casting. The flow is parse -> build (volume, TF, camera, caster) -> run
-// the selected mode -> write. A new mode adds one entry to `modes()` (and its flags in the setup
-// lambda); everything before and after the dispatch is shared, so all modes composite and write alike.
-#include <cmath>
+// raysift render: volume ray casting. The flow is parse (render_flags.h) -> build (volume, TF, camera,
+// caster) -> run the selected mode -> write. A new mode adds one entry to `modes()` (and its flags in
+// render_flags.cpp); everything before and after the dispatch is shared, so all modes composite and write alike.
 #include <cstdio>
 #include <iostream>
 #include <map>
 #include <memory>
 #include <sstream>
 
-#include "apps/raysift/cli_checks.h"
 #include "apps/raysift/command.h"
-#include "apps/raysift/sampling_flags.h"
+#include "apps/raysift/render_flags.h"
 #include "apps/raysift/sampling_stats.h"
-#include "apps/raysift/volume_input.h"
 #include "core/file_util.h"
 #include "core/image.h"
 #include "core/progress.h"
-#include "core/scene.h"
 #include "core/timer.h"
 #include "sampling/camera_path.h"
-#include "isosurface/feature_cache.h"
-#include "sampling/volume_sampling.h"
-#include "volume/raycaster.h"
-#include "volume/transfer_function.h"
 
 namespace raysift::app {
 namespace {
-
-struct RenderCliOptions {
-  std::string volume, grid, tf, camera, out;
-  std::string mode = "full";
-  int width = -1, height = -1;  ///< -1 = from the camera file / scene / 512
-  double step = volume::RenderOptions{}.step_voxels;
-  std::string shading = "none";
-  std::vector<double> background{0, 0, 0};  ///< linear R,G,B
-  std::vector<double> light_dir;            ///< X,Y,Z; empty = headlight
-  double early_termination = volume::RenderOptions{}.early_termination;
-  bool no_skip = false, jitter = false, tf_normalized = false;
-  std::string pixel;  ///< "x,y": trace one pixel serially and print it
-  // Sampled modes (prioritized, subsample): sampling/volume_sampling.h.
-  double ray_fraction = sampling::SamplingOptions{}.ray_fraction;
-  double budget_ms = 0;
-  std::string features = "contours,silhouettes";
-  std::vector<float> alpha;     ///< a00,a10,a01,a11,a20,a02; empty = library default
-  int progressive = 0;
-  std::string feature_mesh;
-  std::string feature_cache;  ///< directory of the on-disk feature cache; empty = memory only
-  bool no_refine = false;
-  std::string interpolation = sampling::SamplingOptions{}.interpolation == sampling::Interpolation::Cubic ? "cubic" : "linear";
-};
-
-/// Everything a mode needs, built once from flags and scene.
-struct RenderInputs {
-  volume::Volume volume;
-  std::unique_ptr<volume::TransferFunction> tf;
-  CameraSpec camera;
-  volume::RenderOptions options;
-  sampling::SampledRenderRequest sampled;  ///< used by the prioritized and subsample modes
-  std::shared_ptr<isosurface::FeatureCache> feature_cache;  ///< sampled.feature_cache points here
-};
 
 /// What a mode returns: the final image (composited, alpha = accumulated opacity) and its counts.
 struct ModeOutput {
@@ -103,105 +62,6 @@ std::vector<std::string> mode_list() {
   return names;
 }
 
-Vec3d light_direction(const std::vector<double>& v) {
-  const Vec3d d{v[0], v[1], v[2]};
-  if (dot(d, d) == 0.0) bad_flag("--light-dir", "three comma-separated finite numbers, not all zero (X,Y,Z)", "0,0,0");
-  return d;
-}
-
-/// The one rule CLI11's needs/excludes cannot state: it depends on the value of --mode.
-void validate(const RenderCliOptions& o) {
-  if ((o.budget_ms > 0 || o.progressive > 0) && o.mode != "prioritized")
-    throw UsageError("--budget-ms and --progressive need --mode prioritized; see --help");
-}
-
-RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common) {
-  VolumeInput input = load_volume_input(o.volume, o.grid, o.tf, o.tf_normalized, common.scene_path, "render");
-  if (!input.tf) throw UsageError("render needs --tf TF.json or a --scene with a 'transfer_function'; see --help");
-  const Scene& scene = input.scene;
-  const volume::GridInfo& info = input.info;
-  RenderInputs in;
-  in.volume = std::move(input.volume);
-  in.tf = std::move(input.tf);
-  if (info.value_max < in.tf->domain_min() || info.value_min > in.tf->domain_max()) {
-    if (!common.quiet)
-      std::cerr << "raysift: warning: the transfer function's range [" << in.tf->domain_min() << ", "
-                << in.tf->domain_max() << "] does not overlap the data range [" << info.value_min << ", "
-                << info.value_max << "]; values are clamped to the end points\n";
-  }
-
-  std::optional<CameraSpec> camera = scene.camera;
-  const std::string camera_source = !o.camera.empty() ? o.camera : scene.source;
-  if (!o.camera.empty()) camera = camera_spec_from_json(read_json_file(o.camera), o.camera);
-  const int width = o.width != -1 ? o.width : camera ? camera->width : CameraSpec{}.width;
-  const int height = o.height != -1 ? o.height : camera ? camera->height : CameraSpec{}.height;
-  if (camera) {
-    in.camera = *camera;
-    in.camera.width = width;
-    in.camera.height = height;
-    try {
-      static_cast<void>(Camera{in.camera});
-    } catch (const InvalidInput& e) {
-      throw InvalidInput(file_message(camera_source, e.what()));
-    }
-  } else {
-    in.camera = volume::fit_camera(in.volume, width, height);
-  }
-
-  in.options.step_voxels = o.step;
-  in.options.shading = o.shading == "phong" ? volume::Shading::Phong : volume::Shading::None;
-  in.options.background = {float(o.background[0]), float(o.background[1]), float(o.background[2])};
-  if (!o.light_dir.empty()) {
-    in.options.phong.headlight = false;
-    in.options.phong.light_dir_ws = light_direction(o.light_dir);
-  }
-  in.options.early_termination = o.early_termination;
-  in.options.skip_empty_space = !o.no_skip;
-  in.options.jitter = o.jitter;
-  in.options.seed = common.seed;
-
-  in.sampled.sampling.mode = sampling::parse_sampling_mode(o.mode);
-  in.sampled.sampling.ray_fraction = o.ray_fraction;
-  in.sampled.sampling.budget_ms = o.budget_ms;
-  in.sampled.sampling.refinement.enabled = !o.no_refine;
-  in.sampled.sampling.interpolation =
-      o.interpolation == "cubic" ? sampling::Interpolation::Cubic : sampling::Interpolation::Linear;
-  in.sampled.sampling.seed = common.seed;
-  in.sampled.progressive_frames = o.progressive;
-  in.sampled.feature_mesh = o.feature_mesh;
-  in.feature_cache = std::make_shared<isosurface::FeatureCache>(o.feature_cache, [quiet = common.quiet](const std::string& w) {
-    if (!quiet) std::cerr << "raysift: warning: " << w << "\n";
-  });
-  in.sampled.feature_cache = in.feature_cache.get();
-  try {
-    if (!o.alpha.empty()) std::copy(o.alpha.begin(), o.alpha.end(), in.sampled.sampling.mapping.alpha.begin());
-    in.sampled.features.classes = sampling::parse_feature_list(o.features);
-  } catch (const InvalidInput& e) {
-    throw UsageError(std::string(e.what()) + "; see --help");
-  }
-  return in;
-}
-
-std::string join(const std::vector<double>& v) {
-  std::ostringstream s;
-  for (std::size_t i = 0; i < v.size(); ++i) s << (i ? "," : "") << v[i];
-  return s.str();
-}
-
-/// The effective options as a command line that reproduces the render (verbose mode).
-std::string echo_command(const RenderCliOptions& o, const RenderInputs& in, const CommonOptions& common) {
-  std::ostringstream s;
-  s << "raysift render " << (o.volume.empty() ? "--scene " + common.scene_path : o.volume);
-  if (!o.tf.empty()) s << " --tf " << o.tf;
-  if (!o.camera.empty()) s << " --camera " << o.camera;
-  s << " --width " << in.camera.width << " --height " << in.camera.height << " --mode " << o.mode << " --step "
-    << o.step << " --shading " << o.shading << (o.light_dir.empty() ? "" : " --light-dir " + join(o.light_dir))
-    << " --background " << join(o.background) << " --early-termination "
-    << o.early_termination << (o.no_skip ? " --no-skip" : "") << (o.jitter ? " --jitter" : "") << " --seed "
-    << common.seed << " --threads " << common.threads << " -o " << o.out;
-  return s.str();
-}
-
 void trace_one_pixel(const std::string& text, const volume::RayCaster& caster) {
   int x = -1, y = -1;
   char comma = 0;
@@ -214,29 +74,6 @@ void trace_one_pixel(const std::string& text, const volume::RayCaster& caster) {
   const Rgba c = volume::composite_over_background(r.color, caster.options().background);
   std::printf("pixel %d,%d: premultiplied %.6g %.6g %.6g %.6g  composited %.6g %.6g %.6g  depth %.6g  samples %u\n",
               x, y, r.color.r, r.color.g, r.color.b, r.color.a, c.r, c.g, c.b, r.depth, r.samples);
-}
-
-// Camera paths (sampling/camera_path.h, issue 9): --camera-path, --target-fps, --compare-full and the
-// "saliency" entry of --features. The whole path is rendered by run_path_request.
-struct PathCliOptions {
-  std::string camera_path;
-  double target_fps = 0;
-  bool compare_full = false;
-  bool use_saliency = false;                 ///< "saliency" taken out of --features before the lines parse it
-};
-
-/// Checks the path flags and takes "saliency" out of --features (before build_inputs parses the classes).
-void prepare_path_flags(PathCliOptions& p, RenderCliOptions& o) {
-  o.features = split_saliency_feature(o.features, p.use_saliency);
-  if (p.camera_path.empty()) {
-    if (p.use_saliency) throw UsageError("--features saliency needs --camera-path; see --help");
-    return;
-  }
-  if (!sampling::is_frame_pattern(o.out))
-    bad_flag("-o/--out", "a frame pattern such as frame_%03d.png with --camera-path", o.out);
-  if (o.progressive > 0 || !o.pixel.empty())
-    throw UsageError("--progressive and --pixel apply to single frames, not to --camera-path "
-                     "(a path refines by itself while consecutive cameras are equal); see --help");
 }
 
 void render_path(const PathCliOptions& p, const RenderCliOptions& o, const RenderInputs& in, const CommonOptions& common) {
@@ -272,75 +109,11 @@ RegisterCommand reg(
     "render", "volume ray casting (emission-absorption, transfer function, empty-space skipping)",
     [](CLI::App& sub, CommonOptions& common) -> RunFunction {
       auto opt = std::make_shared<RenderCliOptions>();
-      sub.add_option("VOLUME", opt->volume, "input .vdb (default: the scene's volume)");
-      sub.add_option("-o,--out", opt->out, "output image: .exr (linear RGB + alpha = opacity) or .png (sRGB, opaque)")
-          ->required()->check(has_extension({".exr", ".png"}));
-      sub.add_option("--grid", opt->grid, "grid name (default: the scene's, else the first float grid)");
-      sub.add_option("--tf", opt->tf, "transfer function JSON (ParaView preset or {\"points\": ...})");
-      sub.add_flag("--tf-normalized", opt->tf_normalized, "TF x values are 0..1 over the data range");
-      sub.add_option("--camera", opt->camera, "camera JSON (default: the scene's, else fitted to the volume)");
-      sub.add_option("--width", opt->width, "image width in pixels (default: camera's, else " +
-                                                std::to_string(CameraSpec{}.width) + ")")->check(image_side());
-      sub.add_option("--height", opt->height, "image height in pixels (default: camera's, else " +
-                                                  std::to_string(CameraSpec{}.height) + ")")->check(image_side());
-      sub.add_option("--mode", opt->mode, "render mode")->check(CLI::IsMember(mode_list()))->capture_default_str();
-      sub.add_option("--step", opt->step, "sample distance in voxels")->check(number_in(0, 64, End::Open))
-          ->capture_default_str();
-      sub.add_option("--shading", opt->shading, "none|phong (Blinn-Phong, headlight)")
-          ->check(CLI::IsMember({"none", "phong"}))->capture_default_str();
-      sub.add_option("--light-dir", opt->light_dir,
-                     "Phong: directional light travelling along X,Y,Z (world); default: headlight")
-          ->delimiter(',')->expected(3)->check(number_in(-INFINITY, INFINITY));
-      sub.add_option("--background", opt->background, "background R,G,B (linear)")->delimiter(',')->expected(3)
-          ->check(number_in(0, 1))->capture_default_str();
-      sub.add_option("--early-termination", opt->early_termination, "stop a ray at this opacity; 1 disables")
-          ->check(number_in(0, 1, End::Open))->capture_default_str();
-      sub.add_flag("--no-skip", opt->no_skip, "disable empty-space skipping (same image, slower)");
-      sub.add_flag("--jitter", opt->jitter, "random start offset per ray (from --seed)");
-      sub.add_option("--pixel", opt->pixel, "debug: trace only pixel x,y serially and print it (no image written)");
-      sub.add_option("--ray-fraction", opt->ray_fraction,
-                     "prioritized/subsample: rays as a fraction of the full render's")
-          ->check(number_in(0, 1, End::Open))->capture_default_str();
-      sub.add_option("--budget-ms", opt->budget_ms, "prioritized: frame time budget in ms (0 = use --ray-fraction)")
-          ->check(number_in(0, INFINITY))->capture_default_str();
-      sub.add_option("--features", opt->features,
-                     "prioritized: line classes for the importance (contours,silhouettes,suggestive,highlights,"
-                     "ridges,valleys|all) or none (pattern-only control)")
-          ->capture_default_str();
-      add_alpha_option(sub, opt->alpha, "prioritized: ");
-      sub.add_option("--progressive", opt->progressive,
-                     "prioritized: render N progressive frames of a still camera, write the last")
-          ->check(CLI::NonNegativeNumber)->capture_default_str();
-      sub.add_option("--feature-mesh", opt->feature_mesh,
-                     "prioritized: prepared feature mesh (e.g. from raysift mesh) instead of extracting iso-surfaces");
-      sub.add_flag("--no-refine", opt->no_refine,
-                   "prioritized: place rays by the a priori queue only (no contrast refinement from level 0)");
-      sub.add_option("--interpolation", opt->interpolation, "sampled modes: reconstruction rule")
-          ->check(CLI::IsMember({"linear", "cubic"}))->capture_default_str();
-      sub.add_option("--feature-cache", opt->feature_cache,
-                     "prioritized: directory caching the feature geometry across runs (keyed by volume, TF, options)");
-      sub.footer(
-          "Examples:\n"
-          "  raysift render datasets/engine_ct.vdb --tf datasets/engine_ct_tf.json -o engine.png\n"
-          "  raysift render --scene datasets/engine_ct_scene.json --shading phong --width 1440 --height 900 "
-          "-o engine.exr --stats stats.json\n"
-          "  raysift render --scene datasets/engine_ct_scene.json --mode prioritized --ray-fraction 0.2 -o p.exr\n"
-          "  raysift render --scene datasets/engine_ct_scene.json --mode subsample --ray-fraction 0.2 -o s.exr");
       auto path = std::make_shared<PathCliOptions>();
-      auto* path_group = sub.add_option_group("Camera path");
-      CLI::Option* path_flag = path_group->add_option(
-          "--camera-path", path->camera_path,
-          "render a sequence: JSON list of cameras, {\"cameras\": [...]} or {\"orbit\": {centre, radius, "
-          "elevation_deg, frames}}; -o is then a pattern such as frame_%03d.png; --features may add saliency");
-      path_group->add_option("--target-fps", path->target_fps, "prioritized: adapt alpha00 to hold this frame rate")
-          ->check(number_in(0, INFINITY, End::Open))->needs(path_flag);
-      path_group->add_flag("--reference,--compare-full", path->compare_full,
-                           "also render every frame fully (untimed) and report ssim_vs_full per frame")
-          ->needs(path_flag);
+      add_render_options(sub, *opt, *path, mode_list());
       return [opt, path, &common] {
         const Timer total;
-        prepare_path_flags(*path, *opt);
-        validate(*opt);
+        check_render_flags(*path, *opt);
         const RenderInputs in = build_inputs(*opt, common);
         if (!path->camera_path.empty()) return render_path(*path, *opt, in, common);
         const volume::RayCaster caster(in.volume, *in.tf, in.camera, in.options);

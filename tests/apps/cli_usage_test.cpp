@@ -146,5 +146,24 @@ TEST(CliUsage, LinesInfoAndDemoValidatorsNameTheFlag) {
                                          });
 }
 
+TEST(CliUsage, MeshImportAndImageValidatorsNameTheFlag) {
+  const std::string m = "mesh v.vdb --tf tf.json -o out.ply ";
+  expect_usage_errors("cli_other_flags", {
+                                             {m + "--iso 1,nan", "--iso"},
+                                             {m + "--max-surfaces 0", "--max-surfaces"},
+                                             {m + "--lambda 0", "--lambda"},
+                                             {m + "--mu 0.2", "--mu"},
+                                             {m + "--decimate 0.5 --faces 100", "--decimate"},
+                                             {m + "--faces 3", "--faces"},
+                                             {"mesh v.vdb --tf tf.json -o out.stl", "--out"},
+                                             {"import v.raw --dims 4,4,4 --type u8 --endian middle -o out.vdb", "--endian"},
+                                             {"import v.raw --dims 4,4,4 --type u8 --spacing 1,0,1 -o out.vdb", "--spacing"},
+                                             {"import v.raw --dims 4,4,4 --type u8 --tolerance -1 -o out.vdb", "--tolerance"},
+                                             {"saliency a.png -o out.png --scale 1.5", "--scale"},
+                                             {"compare a.png b.png --ppd 0", "--ppd"},
+                                             {"make-scene forest -o out.ply", "KIND"},
+                                         });
+}
+
 }  // namespace
 }  // namespace raysift
