@@ -9,8 +9,11 @@ namespace raysift::app {
 
 CLI::Validator number_in(double lo, double hi, End lo_end, End hi_end) {
   std::ostringstream range;
-  range << (lo_end == End::Open ? "(" : "[") << lo << ", " << hi
-        << (hi_end == End::Open || std::isinf(hi) ? ")" : "]");
+  if (std::isinf(lo) && std::isinf(hi)) {
+    range << "(-inf, inf)";  // any finite number
+  } else {
+    range << (lo_end == End::Open ? "(" : "[") << lo << ", " << hi << (hi_end == End::Open || std::isinf(hi) ? ")" : "]");
+  }
   return CLI::Validator(
       [lo, hi, lo_end, hi_end, text = range.str()](std::string& value) -> std::string {
         double v = 0;

@@ -65,40 +65,42 @@ void add_render_options(CLI::App& sub, RenderCliOptions& o, PathCliOptions& p, c
   sub.add_option("--height", o.height, "image height in pixels (default: camera's, else " +
                                               std::to_string(CameraSpec{}.height) + ")")->check(image_side());
   sub.add_option("--mode", o.mode, "render mode")->check(CLI::IsMember(mode_names))->capture_default_str();
-  sub.add_option("--step", o.step, "sample distance in voxels")->check(number_in(0, 64, End::Open))
+  auto* caster = sub.add_option_group("Ray caster");
+  caster->add_option("--step", o.step, "sample distance in voxels")->check(number_in(0, 64, End::Open))
       ->capture_default_str();
-  sub.add_option("--shading", o.shading, "none|phong (Blinn-Phong, headlight)")
+  caster->add_option("--shading", o.shading, "none|phong (Blinn-Phong, headlight)")
       ->check(CLI::IsMember({"none", "phong"}))->capture_default_str();
-  sub.add_option("--light-dir", o.light_dir,
+  caster->add_option("--light-dir", o.light_dir,
                  "Phong: directional light travelling along X,Y,Z (world); default: headlight")
       ->delimiter(',')->expected(3)->check(number_in(-INFINITY, INFINITY));
-  sub.add_option("--background", o.background, "background R,G,B (linear)")->delimiter(',')->expected(3)
+  caster->add_option("--background", o.background, "background R,G,B (linear)")->delimiter(',')->expected(3)
       ->check(number_in(0, 1))->capture_default_str();
-  sub.add_option("--early-termination", o.early_termination, "stop a ray at this opacity; 1 disables")
+  caster->add_option("--early-termination", o.early_termination, "stop a ray at this opacity; 1 disables")
       ->check(number_in(0, 1, End::Open))->capture_default_str();
-  sub.add_flag("--no-skip", o.no_skip, "disable empty-space skipping (same image, slower)");
-  sub.add_flag("--jitter", o.jitter, "random start offset per ray (from --seed)");
-  sub.add_option("--pixel", o.pixel, "debug: trace only pixel x,y serially and print it (no image written)");
-  sub.add_option("--ray-fraction", o.ray_fraction,
+  caster->add_flag("--no-skip", o.no_skip, "disable empty-space skipping (same image, slower)");
+  caster->add_flag("--jitter", o.jitter, "random start offset per ray (from --seed)");
+  caster->add_option("--pixel", o.pixel, "debug: trace only pixel x,y serially and print it (no image written)");
+  auto* sampled = sub.add_option_group("Sampled modes (prioritized, subsample)");
+  sampled->add_option("--ray-fraction", o.ray_fraction,
                  "prioritized/subsample: rays as a fraction of the full render's")
       ->check(number_in(0, 1, End::Open))->capture_default_str();
-  sub.add_option("--budget-ms", o.budget_ms, "prioritized: frame time budget in ms (0 = use --ray-fraction)")
+  sampled->add_option("--budget-ms", o.budget_ms, "prioritized: frame time budget in ms (0 = use --ray-fraction)")
       ->check(number_in(0, INFINITY))->capture_default_str();
-  sub.add_option("--features", o.features,
+  sampled->add_option("--features", o.features,
                  "prioritized: line classes for the importance (contours,silhouettes,suggestive,highlights,"
                  "ridges,valleys|all) or none (pattern-only control)")
       ->capture_default_str();
-  add_alpha_option(sub, o.alpha, "prioritized: ");
-  sub.add_option("--progressive", o.progressive,
+  add_alpha_option(*sampled, o.alpha, "prioritized: ");
+  sampled->add_option("--progressive", o.progressive,
                  "prioritized: render N progressive frames of a still camera, write the last")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
-  sub.add_option("--feature-mesh", o.feature_mesh,
+  sampled->add_option("--feature-mesh", o.feature_mesh,
                  "prioritized: prepared feature mesh (e.g. from raysift mesh) instead of extracting iso-surfaces");
-  sub.add_flag("--no-refine", o.no_refine,
+  sampled->add_flag("--no-refine", o.no_refine,
                "prioritized: place rays by the a priori queue only (no contrast refinement from level 0)");
-  sub.add_option("--interpolation", o.interpolation, "sampled modes: reconstruction rule")
+  sampled->add_option("--interpolation", o.interpolation, "sampled modes: reconstruction rule")
       ->check(CLI::IsMember({"linear", "cubic"}))->capture_default_str();
-  sub.add_option("--feature-cache", o.feature_cache,
+  sampled->add_option("--feature-cache", o.feature_cache,
                  "prioritized: directory caching the feature geometry across runs (keyed by volume, TF, options)");
   sub.footer(
       "Examples:\n"
@@ -106,7 +108,7 @@ void add_render_options(CLI::App& sub, RenderCliOptions& o, PathCliOptions& p, c
       "  raysift render --scene datasets/engine_ct_scene.json --shading phong --width 1440 --height 900 "
       "-o engine.exr --stats stats.json\n"
       "  raysift render --scene datasets/engine_ct_scene.json --mode prioritized --ray-fraction 0.2 -o p.exr\n"
-      "  raysift render --scene datasets/engine_ct_scene.json --mode subsample --ray-fraction 0.2 -o s.exr");
+      "  raysift render --scene datasets/engine_ct_scene.json --mode subsample --ray-fraction 0.2 -o s.exr\n");
   auto* path_group = sub.add_option_group("Camera path");
   CLI::Option* path_flag = path_group->add_option(
       "--camera-path", p.camera_path,
