@@ -27,7 +27,7 @@ RegisterCommand reg(
       sub.add_option("--map", opt->map, "write the per-pixel FLIP error as a grey image (PNG value = error)");
       sub.add_option("--ppd", opt->ppd, "FLIP pixels per degree of visual angle")
           ->check(number_in(0, INFINITY, End::Open))->capture_default_str();
-      sub.footer("Example:\n  raysift compare full.exr prioritized.exr --stats metrics.json --map flip.png");
+      sub.footer("Example:\n  raysift compare full.exr prioritized.exr --stats metrics.json --map flip.png\n");
       return [opt, &common] {
         const ImageRGBA reference = read_image_rgba(opt->reference);
         const ImageRGBA test = read_image_rgba(opt->test);

@@ -51,7 +51,7 @@ RegisterCommand reg(
           "Examples:\n"
           "  raysift import engine.raw.gz --dims 256,256,128 --type u8 -o engine.vdb\n"
           "  raysift import ct.raw --dims 512,512,300 --type u16 --endian big --spacing 0.5,0.5,1 -o ct.vdb\n"
-          "  raysift import head.nrrd --background 0 --tolerance 2 -o head.vdb");
+          "  raysift import head.nrrd --background 0 --tolerance 2 -o head.vdb\n");
       return [opt, &common] {
         const bool nrrd = volume::is_nrrd_path(opt->input);
         if (nrrd && (!opt->dims.empty() || !opt->type.empty()))

@@ -77,7 +77,7 @@ RegisterCommand reg("info", "describe the grids of a .vdb file (bbox, voxel size
                       sub.add_option("--bins", opt->bins, "histogram bins")->check(CLI::PositiveNumber)
                           ->capture_default_str();
                       sub.footer("Examples:\n  raysift info datasets/engine_ct.vdb\n"
-                                 "  raysift info smoke.vdb --grid density --stats smoke_info.json");
+                                 "  raysift info smoke.vdb --grid density --stats smoke_info.json\n");
                       return [opt, &common] {
                         std::string path = opt->volume, grid = opt->grid;
                         if (!common.scene_path.empty()) {

@@ -36,7 +36,7 @@ RegisterCommand reg(
       sub.footer(
           "Examples:\n"
           "  raysift saliency frame.png -o frame_saliency.exr\n"
-          "  raysift saliency frame.exr -o map.png --scale 0.5 --stats saliency.json");
+          "  raysift saliency frame.exr -o map.png --scale 0.5 --stats saliency.json\n");
       return [opt, &common] {
         opt->saliency.use_orientation = !opt->no_orientation;
 

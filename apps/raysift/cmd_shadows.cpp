@@ -94,7 +94,7 @@ void add_options(CLI::App& sub, ShadowsOptions& o) {
                                                  "reference (full at 64/255)");
   sub.footer("Examples:\n  raysift make-scene grass -o grass.ply\n"
              "  raysift shadows grass.ply --light light.json --light-size 1 --method nrr -o nrr.exr "
-             "--reference shadowmap --error-map err.png --stats stats.json");
+             "--reference shadowmap --error-map err.png --stats stats.json\n");
 }
 
 /// The mesh, the light and the output camera from the flags, the scene file or a built-in scene.
