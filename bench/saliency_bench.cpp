@@ -84,7 +84,7 @@ void run_orbit(const volume::Volume& vol, const volume::TransferFunction& tf, co
     opt.compare_full = true;
     const auto path = sampling::render_camera_path(vol, tf, {}, cameras, &geometry, opt,
                                                    [](const sampling::PathFrame&, const ImageRGBA&) {});
-    const Json stats = sampling::path_stats_json(path, target_fps);
+    const sampling::PathSummary summary = sampling::summarize_path(path, target_fps);
     double ms = 0, rays = 0, saliency = 0;
     for (const sampling::PathFrame& f : path) {
       if (per_frame)
@@ -98,16 +98,16 @@ void run_orbit(const volume::Volume& vol, const volume::TransferFunction& tf, co
     }
     const double n = double(path.size());
     Totals& t = totals[use_saliency ? 1 : 0];
-    t.within += stats.at("within_10pct_of_target").get<double>();
+    t.within += summary.within_10pct_of_target;
     t.ms += ms / n;
     t.rays += rays / n;
-    t.ssim += stats.at("mean_ssim_vs_full").get<double>();
+    t.ssim += summary.mean_ssim_vs_full.value_or(0.0);
     t.saliency += saliency / n;
     ++t.runs;
     std::printf("%-26s %9.0f%% %10.1f %9.1f%% %12.4f %10.1f\n",
                 use_saliency ? "contours+sil + saliency" : "contours+silhouettes",
-                100.0 * stats.at("within_10pct_of_target").get<double>(), ms / n, 100.0 * rays / n,
-                stats.at("mean_ssim_vs_full").get<double>(), saliency / n);
+                100.0 * summary.within_10pct_of_target, ms / n, 100.0 * rays / n,
+                summary.mean_ssim_vs_full.value_or(0.0), saliency / n);
   }
   for (int v = 0; v < 2; ++v) {
     const Totals& t = totals[v];

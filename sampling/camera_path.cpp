@@ -315,9 +315,9 @@ std::vector<PathFrame> render_camera_path(const volume::Volume& volume, const vo
   std::optional<FrameRateController> controller;
   if (options.target_fps != 0) {
     if (mode != SamplingMode::Prioritized)
-      throw InvalidInput("--target-fps needs --mode prioritized, got --mode " + std::string(sampling_mode_name(mode)));
+      throw InvalidInput("a target frame rate needs the prioritized mode, got " + std::string(sampling_mode_name(mode)));
     if (options.sampling.budget_ms > 0)
-      throw InvalidInput("--target-fps adapts alpha00 and cannot be combined with a per-frame time budget; give one");
+      throw InvalidInput("a target frame rate adapts alpha00 and cannot be combined with a per-frame time budget; give one");
     FrameRateOptions fo;
     fo.target_fps = options.target_fps;
     fo.threshold = std::isfinite(options.sampling.threshold) ? options.sampling.threshold : fo.threshold;
@@ -407,21 +407,6 @@ std::vector<PathFrame> render_camera_path(const volume::Volume& volume, const vo
   return frames;
 }
 
-std::string split_saliency_feature(const std::string& list, bool& has_saliency) {
-  has_saliency = false;
-  std::string rest;
-  std::stringstream items(list);
-  std::string item;
-  while (std::getline(items, item, ',')) {
-    if (item == "saliency") {
-      has_saliency = true;
-    } else if (!item.empty() && item != "none") {
-      rest += (rest.empty() ? "" : ",") + item;
-    }
-  }
-  return rest.empty() ? "none" : rest;
-}
-
 namespace {
 /// The path's camera that sees the volume at the finest importance resolution: one geometry serves the path.
 isosurface::FeatureView finest_view(const volume::Volume& volume, const std::vector<CameraSpec>& cameras, double scale) {
@@ -436,11 +421,9 @@ isosurface::FeatureView finest_view(const volume::Volume& volume, const std::vec
 }
 }  // namespace
 
-Json run_path_request(const volume::Volume& volume, const volume::TransferFunction& tf,
-                      const volume::RenderOptions& render, const CameraSpec& camera, const PathRenderRequest& request) {
-  if (!is_frame_pattern(request.out_pattern))
-    throw InvalidInput("-o/--out must be a frame pattern with one integer conversion such as frame_%03d.png when "
-                       "rendering a camera path, got '" + request.out_pattern + "'");
+PathRenderResult run_path_request(const volume::Volume& volume, const volume::TransferFunction& tf,
+                                  const volume::RenderOptions& render, const CameraSpec& camera,
+                                  const PathRenderRequest& request, const PathFrameSink& sink) {
   const Timer total;
   const std::vector<CameraSpec> cameras = load_camera_path(request.camera_path, camera);
   const Timer setup;
@@ -452,53 +435,28 @@ Json run_path_request(const volume::Volume& volume, const volume::TransferFuncti
   } else if (!request.options.features.lines.classes.is_empty()) {
     geometry = load_feature_geometry(request.feature_mesh, &volume);
   }
-  const double setup_ms = setup.elapsed_ms();
-  const auto frames = render_camera_path(volume, tf, render, cameras, geometry ? &*geometry : nullptr, request.options,
-                                         [&](const PathFrame& frame, const ImageRGBA& image) {
-                                           const std::string name = frame_file_name(request.out_pattern, frame.index);
-                                           if (file_extension(name) != ".png") return write_image(name, image);
-                                           ImageRGBA opaque = image;  // composited colour: show it opaque, as render does
-                                           for (Rgba& p : opaque.pixels) p.a = 1.0f;
-                                           write_image(name, opaque);
-                                         });
-  Json stats = path_stats_json(frames, request.options.target_fps);
-  stats["camera_path"] = request.camera_path;
-  stats["frame_files"] = {frame_file_name(request.out_pattern, 0),
-                          frame_file_name(request.out_pattern, int(frames.size()) - 1)};
-  stats["times_ms"] = {{"features_setup", setup_ms}, {"total", total.elapsed_ms()}};
-  return stats;
+  PathRenderResult out;
+  out.features_setup_ms = setup.elapsed_ms();
+  out.frames = render_camera_path(volume, tf, render, cameras, geometry ? &*geometry : nullptr, request.options, sink);
+  out.total_ms = total.elapsed_ms();
+  return out;
 }
 
-Json path_stats_json(const std::vector<PathFrame>& frames, double target_fps) {
-  Json list = Json::array();
+PathSummary summarize_path(const std::vector<PathFrame>& frames, double target_fps) {
+  PathSummary summary;
   double ssim_sum = 0;
   std::size_t ssim_n = 0, within = 0;
-  const double target_ms = target_fps > 0 ? 1000.0 / target_fps : 0;
+  summary.target_ms = target_fps > 0 ? 1000.0 / target_fps : 0;
   for (const PathFrame& f : frames) {
-    Json j = {{"index", f.index},
-              {"ms", f.ms},
-              {"importance_ms", f.importance_ms},
-              {"saliency_ms", f.saliency_ms},
-              {"trace_ms", f.trace_ms},
-              {"rays_traced", f.rays_traced},
-              {"full_rays", f.full_rays},
-              {"alpha00", f.alpha00},
-              {"refined", f.refined}};
-    j["ssim_vs_full"] = std::isfinite(f.ssim_vs_full) ? Json(f.ssim_vs_full) : Json(nullptr);
     if (std::isfinite(f.ssim_vs_full)) {
       ssim_sum += f.ssim_vs_full;
       ++ssim_n;
     }
-    if (target_ms > 0 && f.ms <= 1.1 * target_ms) ++within;
-    list.push_back(j);
+    if (summary.target_ms > 0 && f.ms <= 1.1 * summary.target_ms) ++within;
   }
-  Json stats = {{"frames", list}};
-  if (target_ms > 0) {
-    stats["target_ms"] = target_ms;
-    stats["within_10pct_of_target"] = frames.empty() ? 0.0 : double(within) / double(frames.size());
-  }
-  if (ssim_n > 0) stats["mean_ssim_vs_full"] = ssim_sum / double(ssim_n);
-  return stats;
+  if (summary.target_ms > 0) summary.within_10pct_of_target = frames.empty() ? 0.0 : double(within) / double(frames.size());
+  if (ssim_n > 0) summary.mean_ssim_vs_full = ssim_sum / double(ssim_n);
+  return summary;
 }
 
 }  // namespace raysift::sampling

@@ -8,6 +8,7 @@
 /// on a path and a one-frame path equals a single render.
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -112,31 +113,35 @@ std::vector<PathFrame> render_camera_path(const volume::Volume& volume, const vo
                                           const FeatureGeometry* geometry, const PathRenderOptions& options,
                                           const PathFrameSink& sink);
 
-/// \brief Splits a `--features` list into the line-class list and the image-space feature: removes the
-/// entry "saliency" (setting `has_saliency`) and returns the rest, "none" when nothing is left.
-std::string split_saliency_feature(const std::string& list, bool& has_saliency);
-
 /// What `raysift render --camera-path` asks for (the app fills it from its flags).
 struct PathRenderRequest {
   std::string camera_path;            ///< JSON file (see camera_path_from_json)
-  std::string out_pattern;            ///< printf pattern with one integer conversion, e.g. frame_%03d.png
   PathRenderOptions options;
   FeatureGeometryOptions geometry;    ///< used when line classes are enabled
   isosurface::FeatureCache* feature_cache = nullptr;  ///< optional, not owned
   std::string feature_mesh;           ///< non-empty: load the feature geometry from this mesh instead
 };
 
-/// \brief Loads the path (missing orbit fields from `camera`), builds the feature geometry when line
-/// classes are enabled, renders every frame and writes it to out_pattern formatted with its index.
-/// \return path_stats_json plus "camera_path", "frame_files" (first and last name) and "times_ms"
-///         {"features_setup", "total"}.
-/// \throw InvalidInput / IoError naming the file or flag at fault.
-Json run_path_request(const volume::Volume& volume, const volume::TransferFunction& tf,
-                      const volume::RenderOptions& render, const CameraSpec& camera, const PathRenderRequest& request);
+struct PathRenderResult {
+  std::vector<PathFrame> frames;
+  double features_setup_ms = 0;  ///< feature geometry build or load (not part of any frame)
+  double total_ms = 0;           ///< path load, set-up and every frame
+};
 
-/// The stats of a path: {"frames": [{"index", "ms", "importance_ms", "saliency_ms", "trace_ms",
-/// "rays_traced", "full_rays", "alpha00", "refined", "ssim_vs_full" (null without compare)}], "target_ms" (when set), "within_10pct_of_target"
-/// (share of frames with ms <= 1.1 target), "mean_ssim_vs_full" (when compared)}.
-Json path_stats_json(const std::vector<PathFrame>& frames, double target_fps);
+/// \brief Loads the path (missing orbit fields from `camera`), builds the feature geometry when line
+/// classes are enabled, and renders every frame, handing each to `sink` as soon as it is done.
+/// \throw InvalidInput / IoError naming the file at fault, or as render_camera_path.
+PathRenderResult run_path_request(const volume::Volume& volume, const volume::TransferFunction& tf,
+                                  const volume::RenderOptions& render, const CameraSpec& camera,
+                                  const PathRenderRequest& request, const PathFrameSink& sink);
+
+/// How a path kept its frame rate and quality.
+struct PathSummary {
+  double target_ms = 0;                     ///< 1000 / target_fps; 0 without a target
+  double within_10pct_of_target = 0;        ///< share of frames with ms <= 1.1 target_ms (with a target)
+  std::optional<double> mean_ssim_vs_full;  ///< over the frames compared with their full render
+};
+
+PathSummary summarize_path(const std::vector<PathFrame>& frames, double target_fps);
 
 }  // namespace raysift::sampling

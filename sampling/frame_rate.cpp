@@ -61,7 +61,7 @@ std::size_t RayCountCurve::rays_at(float alpha00) const {
 void validate(const FrameRateOptions& options) {
   std::ostringstream why;
   if (!(std::isfinite(options.target_fps) && options.target_fps > 0)) {
-    why << "--target-fps must be a number > 0, got " << options.target_fps;
+    why << "the target frame rate must be a number > 0 fps, got " << options.target_fps;
     throw InvalidInput(why.str());
   }
   if (!std::isfinite(options.threshold) || !std::isfinite(options.initial_alpha00))

@@ -135,7 +135,7 @@ SamplingMode parse_sampling_mode(const std::string& name) {
   if (name == "full") return SamplingMode::Full;
   if (name == "prioritized") return SamplingMode::Prioritized;
   if (name == "subsample") return SamplingMode::Subsample;
-  throw InvalidInput("--mode must be one of: full, prioritized, subsample; got '" + name + "'");
+  throw InvalidInput("the sampling mode must be one of: full, prioritized, subsample; got '" + name + "'");
 }
 
 const char* sampling_mode_name(SamplingMode mode) {
@@ -149,15 +149,15 @@ const char* sampling_mode_name(SamplingMode mode) {
 
 void validate(const SamplingOptions& o) {
   if (!(o.ray_fraction > 0.0 && o.ray_fraction <= 1.0))
-    throw InvalidInput("--ray-fraction must be in (0, 1], got " + std::to_string(o.ray_fraction));
+    throw InvalidInput("the ray fraction must be in (0, 1], got " + std::to_string(o.ray_fraction));
   if (!std::isfinite(o.budget_ms) || o.budget_ms < 0)
-    throw InvalidInput("--budget-ms must be >= 0 (0 = no budget), got " + std::to_string(o.budget_ms));
+    throw InvalidInput("the frame budget must be >= 0 ms (0 = no budget), got " + std::to_string(o.budget_ms));
   if (o.base_spacing < 1 || o.base_spacing > 128 || (o.base_spacing & (o.base_spacing - 1)) != 0)
     throw InvalidInput("fractal base spacing must be a power of two in 1..128, got " + std::to_string(o.base_spacing));
   if (o.buckets < 1 || o.buckets > 65536)
     throw InvalidInput("priority bucket count must be in 1..65536, got " + std::to_string(o.buckets));
   for (float a : o.mapping.alpha)
-    if (!std::isfinite(a)) throw InvalidInput("--alpha coefficients must be finite");
+    if (!std::isfinite(a)) throw InvalidInput("the priority mapping's alpha coefficients must be finite");
 }
 
 ImageF control_importance(const ImageF& importance) {
@@ -247,7 +247,7 @@ ProgressiveSampler::ProgressiveSampler(const ImageF& importance, const SamplingO
   validate(options);
   require_finite_importance(importance);
   if (options.mode != SamplingMode::Prioritized)
-    throw InvalidInput("--progressive needs --mode prioritized, got " + std::string(sampling_mode_name(options.mode)));
+    throw InvalidInput("progressive frames need the prioritized mode, got " + std::string(sampling_mode_name(options.mode)));
   const Timer timer;
   pattern_ = make_fractal_pattern(importance.width, importance.height, options.base_spacing);
   queue_ = make_bucketed_queue(importance, pattern_, options.mapping, options.buckets, options.seed);

@@ -49,12 +49,12 @@ PriorityMapping parse_priority_mapping(const std::string& text) {
       if (used != item.size() || !std::isfinite(v)) throw std::invalid_argument(item);
       mapping.alpha[n] = v;
     } catch (const std::exception&) {
-      throw InvalidInput("--alpha: '" + item + "' is not a finite number; expected a00,a10,a01,a11,a20,a02");
+      throw InvalidInput("priority mapping: '" + item + "' is not a finite number; expected a00,a10,a01,a11,a20,a02");
     }
     ++n;
   }
   if (n != 6 || std::count(text.begin(), text.end(), ',') != 5)
-    throw InvalidInput("--alpha needs six comma-separated numbers a00,a10,a01,a11,a20,a02, got '" + text + "'");
+    throw InvalidInput("a priority mapping needs six comma-separated numbers a00,a10,a01,a11,a20,a02, got '" + text + "'");
   return mapping;
 }
 

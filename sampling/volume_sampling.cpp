@@ -29,17 +29,9 @@ FeatureGeometry request_geometry(const volume::Volume& volume, const volume::Tra
   return build_feature_geometry(volume, tf, options, request.feature_cache);
 }
 
-Json geometry_stats(const FeatureGeometry& geometry) {
-  const isosurface::StageTimes& t = geometry.stages;
-  return {{"feature_triangles", geometry.mesh.triangles.size()},
-          {"iso_values", geometry.iso_values},
-          {"feature_coarsening", geometry.coarsening},
-          {"hidden_iso_values", geometry.hidden_iso_values},
-          {"feature_cache_hit", geometry.from_cache},
-          {"features_setup_ms",
-           {{"level", geometry.level_ms}, {"probe", geometry.probe_ms}, {"iso_choice", t.iso_choice_ms},
-            {"marching_cubes", t.marching_cubes.ms}, {"smooth_before", t.smooth_before.ms},
-            {"decimate", t.decimate.ms}, {"smooth_after", t.smooth_after.ms}, {"curvature", geometry.curvature_ms}}}};
+FeatureGeometrySummary summarize(const FeatureGeometry& g) {
+  return {g.mesh.triangles.size(), g.iso_values, g.hidden_iso_values, g.coarsening, g.from_cache, g.build_ms,
+          g.level_ms,            g.probe_ms,    g.curvature_ms,        g.stages};
 }
 
 }  // namespace
@@ -114,7 +106,7 @@ SampledRender render_sampled_volume(const volume::Volume& volume, const volume::
                                     const volume::RayCaster& caster, const SampledRenderRequest& request) {
   validate(request.sampling);
   if (request.progressive_frames < 0)
-    throw InvalidInput("--progressive must be >= 0, got " + std::to_string(request.progressive_frames));
+    throw InvalidInput("the progressive frame count must be >= 0, got " + std::to_string(request.progressive_frames));
   const bool wants_features = request.sampling.mode == SamplingMode::Prioritized && !request.features.classes.is_empty();
   // A TF that hides every value leaves no surface for lines (and an empty frame): render without them.
   const bool skip_features = wants_features && request.feature_mesh.empty() && transparent_over_data(volume, tf);
@@ -124,25 +116,20 @@ SampledRender render_sampled_volume(const volume::Volume& volume, const volume::
 
   SampledRender out;
   out.features_skipped = skip_features;
-  Json& stats = out.stats;
-  stats["mode"] = sampling_mode_name(request.sampling.mode);
-  stats["features"] = uses_features ? Json("lines") : Json("none");
-  if (uses_features) stats.update(geometry_stats(geometry));
+  out.mode = request.sampling.mode;
+  if (uses_features) out.features = summarize(geometry);
   auto fill = [&](const SampledFrame& f, double importance_ms, double total_ms, std::uint64_t samples) {
-    stats["rays_traced"] = f.rays_traced;
-    stats["samples"] = samples;
-    stats["full_rays"] = f.full_rays;
-    stats["level0_rays"] = f.level0_rays;
-    stats["ray_fraction"] = f.full_rays ? double(f.rays_traced) / double(f.full_rays) : 0.0;
-    stats["times_ms"] = {{"importance", importance_ms}, {"priorities", f.priorities_ms}, {"trace", f.trace_ms},
-                         {"reconstruct", f.reconstruct_ms}, {"total", total_ms}, {"frame", total_ms},
-                         {"features_setup", uses_features ? geometry.build_ms : 0.0}};
-    if (request.sampling.budget_ms > 0) {
-      stats["budget_ms"] = request.sampling.budget_ms;
-      stats["budget_too_small"] = f.budget_too_small;
-      stats["overshoot_ms"] = std::max(0.0, total_ms - request.sampling.budget_ms);
-    }
-    out.budget_too_small = out.budget_too_small || f.budget_too_small;
+    out.rays_traced = f.rays_traced;
+    out.samples = samples;
+    out.full_rays = f.full_rays;
+    out.level0_rays = f.level0_rays;
+    out.importance_ms = importance_ms;
+    out.priorities_ms = f.priorities_ms;
+    out.trace_ms = f.trace_ms;
+    out.reconstruct_ms = f.reconstruct_ms;
+    out.frame_ms = total_ms;
+    out.budget_too_small = f.budget_too_small;
+    out.any_budget_too_small = out.any_budget_too_small || f.budget_too_small;
   };
 
   if (request.progressive_frames == 0) {
@@ -156,17 +143,15 @@ SampledRender render_sampled_volume(const volume::Volume& volume, const volume::
   const double importance_ms = first.elapsed_ms();
   SamplingOptions sampling = request.sampling;
   ProgressiveSampler sampler(importance, sampling);
-  Json frames = Json::array();
   SampledFrame frame;
   for (int k = 0; k < request.progressive_frames && !(k > 0 && sampler.converged()); ++k) {
     const Timer timer;
     std::atomic<std::uint64_t> samples{0};
     frame = sampler.next_frame(caster_trace_batch(caster, &samples));
     const double ms = timer.elapsed_ms() + (k == 0 ? importance_ms : 0.0);
-    frames.push_back({{"rays_traced", frame.rays_traced}, {"total_ms", ms}, {"budget_too_small", frame.budget_too_small}});
+    out.progressive.push_back({frame.rays_traced, ms, frame.budget_too_small});
     fill(frame, k == 0 ? importance_ms : 0.0, ms, samples.load());
   }
-  stats["progressive"] = frames;
   out.image = composite_frame(frame.image, caster.options().background);
   return out;
 }

@@ -5,11 +5,12 @@
 /// with the background colour exactly) is the caster's own exact per-pixel test, so every mode at ray
 /// fraction 1 reproduces render_full bit for bit; the line importance buffer, which may be at a lower
 /// resolution, only supplies p_imp on object pixels.
+#include <optional>
 #include <string>
 #include <vector>
 
-#include "core/json_io.h"
 
+#include "core/image.h"
 #include "features/importance.h"
 #include "features/lines.h"
 #include "isosurface/feature_geometry.h"
@@ -70,14 +71,35 @@ struct SampledRenderRequest {
   int progressive_frames = 0;           ///< > 0: that many progressive frames, the last one is returned
 };
 
-/// The final composited image and the stats keys mode, rays_traced, full_rays, level0_rays, ray_fraction,
-/// times_ms {importance, priorities, trace, reconstruct, total, features_setup} (total = the frame:
-/// importance + priorities + trace + reconstruct; features_setup is view-independent and excluded),
-/// and, when used, budget_ms, budget_too_small, feature_triangles, iso_values, progressive (per frame).
+/// What the feature geometry held and cost, without its mesh.
+struct FeatureGeometrySummary {
+  std::size_t triangles = 0;
+  std::vector<double> iso_values, hidden_iso_values;
+  int coarsening = 1;
+  bool from_cache = false;
+  double build_ms = 0, level_ms = 0, probe_ms = 0, curvature_ms = 0;  ///< see FeatureGeometry
+  isosurface::StageTimes stages;
+};
+
+/// One frame of a progressive render.
+struct ProgressiveFrameStats {
+  std::size_t rays_traced = 0;
+  double total_ms = 0;
+  bool budget_too_small = false;
+};
+
+/// The final composited image and the counts and times of its (last) frame.
 struct SampledRender {
   ImageRGBA image;
-  Json stats;
-  bool budget_too_small = false;
+  SamplingMode mode = SamplingMode::Prioritized;
+  std::optional<FeatureGeometrySummary> features;  ///< set when line features drove the importance
+  std::size_t rays_traced = 0, full_rays = 0, level0_rays = 0;
+  std::uint64_t samples = 0;
+  /// The frame: importance + priorities + trace + reconstruct (ms); features_setup is view-independent.
+  double importance_ms = 0, priorities_ms = 0, trace_ms = 0, reconstruct_ms = 0, frame_ms = 0;
+  bool budget_too_small = false;      ///< the last frame's level-0 pattern alone overran the budget
+  bool any_budget_too_small = false;  ///< any frame's did
+  std::vector<ProgressiveFrameStats> progressive;  ///< one per frame of a progressive render, else empty
   /// The TF is transparent over the whole data range: no surface feeds the lines, the frame used none.
   bool features_skipped = false;
 };

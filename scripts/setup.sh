@@ -1,17 +1,23 @@
 #!/usr/bin/env bash
 # Fresh Debian 12 -> working raysift. Usage: scripts/setup.sh demo|test
-#   demo: install missing packages, configure, build, summarise and render the bundled engine CT
-#   test: install missing packages, configure, build, run every test (ctest)
+#   demo: install the packages the program needs, build only the `raysift` target, run `raysift demo` on the
+#         bundled engine CT (full, prioritized and subsampled at the same frame time, side by side)
+#   test: install every package, build everything (tests, benches), run every test, then the demo
 set -euo pipefail
 mode=${1:-demo}
 cd "$(dirname "$0")/.."
 
+# What the raysift program itself links; tests, benches and the shell tools come on top for `test`.
 packages=(cmake g++ make pkg-config ccache zlib1g-dev
-  libopenvdb-dev libboost-iostreams-dev libopenvdb-tools
+  libopenvdb-dev libboost-iostreams-dev
   libopenmesh-dev libmeshoptimizer-dev libembree-dev
-  libopenimageio-dev libopencv-core-dev openimageio-tools
-  libtbb-dev libgtest-dev libbenchmark-dev
-  nlohmann-json3-dev libcli11-dev)
+  libopenimageio-dev libopencv-core-dev
+  libtbb-dev nlohmann-json3-dev libcli11-dev)
+case "$mode" in
+  demo) build_all=OFF ;;
+  test) build_all=ON; packages+=(libgtest-dev libbenchmark-dev libopenvdb-tools openimageio-tools) ;;
+  *) echo "usage: scripts/setup.sh demo|test" >&2; exit 2 ;;
+esac
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -22,20 +28,11 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${missing[@]}"
 fi
 
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
-cmake --build build -j2
-
-case "$mode" in
-  demo)
-    ./build/raysift info datasets/engine_ct.vdb
-    ./build/raysift render --scene datasets/engine_ct_scene.json --shading phong -o build/demo.png --stats build/demo_stats.json
-    echo "demo: wrote build/demo.png (stats: build/demo_stats.json)"
-    ;;
-  test)
-    ctest --test-dir build --output-on-failure -j2
-    ;;
-  *)
-    echo "usage: scripts/setup.sh demo|test" >&2
-    exit 2
-    ;;
-esac
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DRAYSIFT_BUILD_TESTS=$build_all -DRAYSIFT_BUILD_BENCH=$build_all
+if [ "$mode" = test ]; then
+  cmake --build build -j2
+  ctest --test-dir build --output-on-failure -j2
+else
+  cmake --build build -j2 --target raysift
+fi
+./build/raysift demo --scene datasets/engine_ct_scene.json -o build/demo.png --stats build/demo_stats.json

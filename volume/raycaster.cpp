@@ -15,6 +15,7 @@
 #include <cstring>
 #include <sstream>
 
+#include "core/camera_fit.h"
 #include "core/errors.h"
 #include "core/parallel.h"
 #include "volume/detail/brick_cache.h"
@@ -641,28 +642,13 @@ bool RayCaster::pixel_is_background(int x, int y) const {
 }
 
 CameraSpec fit_camera(const Volume& volume, int width, int height) {
-  CameraSpec c;
-  c.width = width;
-  c.height = height;
-  c.fov_y_deg = 30.0;
-  static_cast<void>(Camera{c});  // validates the image size
   const GridInfo info = volume.info();
   Bbox3d box;
   if (info.active_voxels > 0) {
     box.expand(info.bbox_min);
     box.expand(info.bbox_max);
-  } else {
-    box.expand({-0.5, -0.5, -0.5});
-    box.expand({0.5, 0.5, 0.5});
   }
-  const double radius = std::max(0.5 * box.diagonal(), 1e-6);
-  const double half_y = 0.5 * c.fov_y_deg * M_PI / 180.0;
-  const double half_x = std::atan(std::tan(half_y) * double(width) / double(height));
-  const double distance = radius / std::sin(std::min(half_x, half_y));
-  c.target = box.center();
-  c.eye = c.target + Vec3d{0, 0, distance};
-  c.up = {0, 1, 0};
-  return c;
+  return fit_camera_to_box(box, width, height);
 }
 
 RenderResult render_full(const RayCaster& caster, const ProgressCallback& progress, bool threaded) {

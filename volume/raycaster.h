@@ -131,9 +131,8 @@ struct RenderResult {
   std::uint64_t samples = 0;
 };
 
-/// Default view of a volume: ParaView's default direction (eye on the +z side of the world bbox centre,
-/// up = +y), vertical field of view 30°, at the distance where the bbox's bounding sphere just fits the
-/// narrower image axis. An empty volume gets the view of a unit box at the origin.
+/// Default view of a volume: core/camera_fit.h's fit_camera_to_box of the active voxels' world box (an empty
+/// volume gets the view of a unit box at the origin).
 /// \throw InvalidInput for an image side outside 1..kMaxImageSide.
 CameraSpec fit_camera(const Volume& volume, int width, int height);
 

@@ -72,15 +72,37 @@ std::uint64_t count_non_finite(const openvdb::FloatGrid& grid) {
 
 }  // namespace
 
+namespace {
+
+/// default_grid_name's rule as an index (names need not be unique); -1 for no float grid.
+std::ptrdiff_t default_grid_index(const std::vector<GridInfo>& grids) {
+  std::ptrdiff_t first_float = -1;
+  for (std::size_t i = 0; i < grids.size(); ++i) {
+    if (grids[i].type != "float") continue;
+    if (grids[i].active_voxels > 0) return std::ptrdiff_t(i);
+    if (first_float < 0) first_float = std::ptrdiff_t(i);
+  }
+  return first_float;
+}
+
+}  // namespace
+
+std::string default_grid_name(const std::vector<GridInfo>& grids) {
+  const std::ptrdiff_t i = default_grid_index(grids);
+  return i < 0 ? "" : grids[std::size_t(i)].name;
+}
+
 Volume load_vdb(const std::string& path, const std::string& grid_name, EmptyGrid empty) {
   const openvdb::GridPtrVec grids = read_all_grids(path);
   openvdb::GridBase::Ptr chosen;
   if (grid_name.empty()) {
-    for (const auto& g : grids)
-      if (g->isType<openvdb::FloatGrid>()) {
-        chosen = g;
-        break;
-      }
+    std::vector<GridInfo> kinds(grids.size());  // only what the rule reads: no value range is computed here
+    for (std::size_t i = 0; i < grids.size(); ++i) {
+      kinds[i].type = grids[i]->isType<openvdb::FloatGrid>() ? "float" : grids[i]->valueType();
+      kinds[i].active_voxels = grids[i]->activeVoxelCount();
+    }
+    const std::ptrdiff_t i = default_grid_index(kinds);
+    if (i >= 0) chosen = grids[std::size_t(i)];
     if (!chosen)
       throw InvalidInput(file_message(path, "no float grid to load; " + describe_grids(grids) +
                                                 " (raysift renders scalar float grids only)"));

@@ -12,8 +12,12 @@ namespace raysift::volume {
 /// Whether load_vdb accepts a grid with no active voxels.
 enum class EmptyGrid { Reject, Allow };
 
+/// The one default-grid rule of every command: the first float grid with active voxels, else the first
+/// float grid; "" when the file has no float grid.
+std::string default_grid_name(const std::vector<GridInfo>& grids);
+
 /// Loads one float grid.
-/// \param grid_name the grid to load; "" = the first FloatGrid in the file.
+/// \param grid_name the grid to load; "" = default_grid_name of the file's grids.
 /// \throw IoError the file is missing, a directory, unreadable, not a VDB file, truncated or corrupt.
 /// \throw InvalidInput no grid of that name (the message lists the grids), the grid is not a float grid (the
 ///        message names its type), the file has no float grid, the grid is empty (unless `empty` is Allow),

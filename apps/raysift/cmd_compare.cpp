@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "apps/raysift/cli_checks.h"
 #include "apps/raysift/command.h"
 #include "core/file_util.h"
 #include "core/image.h"
@@ -24,10 +25,10 @@ RegisterCommand reg(
       sub.add_option("B", opt->test, "test image, same size")->required();
       sub.add_option("--mask", opt->mask, "object mask image (first channel > 0.5 = object); default: alpha of A > 0");
       sub.add_option("--map", opt->map, "write the per-pixel FLIP error as a grey image (PNG value = error)");
-      sub.add_option("--ppd", opt->ppd, "FLIP pixels per degree of visual angle")->capture_default_str();
-      sub.footer("Example:\n  raysift compare full.exr prioritized.exr --stats metrics.json --map flip.png");
+      sub.add_option("--ppd", opt->ppd, "FLIP pixels per degree of visual angle")
+          ->check(number_in(0, INFINITY, End::Open))->capture_default_str();
+      sub.footer("Example:\n  raysift compare full.exr prioritized.exr --stats metrics.json --map flip.png\n");
       return [opt, &common] {
-        if (!(opt->ppd > 0)) bad_flag("--ppd", "> 0", std::to_string(opt->ppd));
         const ImageRGBA reference = read_image_rgba(opt->reference);
         const ImageRGBA test = read_image_rgba(opt->test);
         sampling::ImageMask mask;

@@ -5,6 +5,7 @@
 #include <limits>
 #include <memory>
 
+#include "apps/raysift/cli_checks.h"
 #include "apps/raysift/command.h"
 #include "core/errors.h"
 #include "core/timer.h"
@@ -34,20 +35,23 @@ RegisterCommand reg(
       sub.add_option("-o,--out", opt->out, "output .vdb (written atomically)")->required();
       sub.add_option("--dims", opt->dims, "raw only: voxels X,Y,Z")->delimiter(',')->expected(3);
       sub.add_option("--type", opt->type, "raw only: voxel type u8|i8|u16|i16|u32|i32|f32|f64");
-      sub.add_option("--endian", opt->endian, "raw only: byte order little|big")->capture_default_str();
+      sub.add_option("--endian", opt->endian, "raw only: byte order")->check(CLI::IsMember({"little", "big"}))
+          ->capture_default_str();
       sub.add_option("--spacing", opt->spacing, "world units per voxel SX,SY,SZ (default 1,1,1 or the NRRD header's)")
           ->delimiter(',')
-          ->expected(3);
+          ->expected(3)
+          ->check(number_in(0, INFINITY, End::Open));
       sub.add_option("--grid", opt->grid, "output grid name")->capture_default_str();
-      sub.add_option("--background", opt->background, "value of inactive voxels (file units)")->capture_default_str();
+      sub.add_option("--background", opt->background, "value of inactive voxels (file units)")
+          ->check(number_in(-INFINITY, INFINITY))->capture_default_str();
       sub.add_option("--tolerance", opt->tolerance, "|v - background| <= tolerance stays inactive")
-          ->capture_default_str();
+          ->check(number_in(0, INFINITY))->capture_default_str();
       sub.add_flag("--half", opt->half, "store values as 16-bit floats on disk (about half the file size)");
       sub.footer(
           "Examples:\n"
           "  raysift import engine.raw.gz --dims 256,256,128 --type u8 -o engine.vdb\n"
           "  raysift import ct.raw --dims 512,512,300 --type u16 --endian big --spacing 0.5,0.5,1 -o ct.vdb\n"
-          "  raysift import head.nrrd --background 0 --tolerance 2 -o head.vdb");
+          "  raysift import head.nrrd --background 0 --tolerance 2 -o head.vdb\n");
       return [opt, &common] {
         const bool nrrd = volume::is_nrrd_path(opt->input);
         if (nrrd && (!opt->dims.empty() || !opt->type.empty()))
@@ -55,16 +59,8 @@ RegisterCommand reg(
                            " gives them; see --help");
         if (!nrrd && (opt->dims.empty() || opt->type.empty()))
           throw UsageError("raw input " + opt->input + " needs --dims X,Y,Z and --type; see --help");
-        if (opt->endian != "little" && opt->endian != "big") bad_flag("--endian", "little or big", opt->endian);
         volume::ImportOptions options;
-        if (!opt->spacing.empty()) {
-          for (double s : opt->spacing)
-            if (!(s > 0 && std::isfinite(s))) bad_flag("--spacing", "positive and finite on every axis", std::to_string(s));
-          options.spacing = Vec3d(opt->spacing[0], opt->spacing[1], opt->spacing[2]);
-        }
-        if (!(opt->tolerance >= 0) || !std::isfinite(opt->tolerance))
-          bad_flag("--tolerance", ">= 0", std::to_string(opt->tolerance));
-        if (!std::isfinite(opt->background)) bad_flag("--background", "finite", std::to_string(opt->background));
+        if (!opt->spacing.empty()) options.spacing = Vec3d(opt->spacing[0], opt->spacing[1], opt->spacing[2]);
         if (opt->grid.empty()) bad_flag("--grid", "a non-empty name", "''");
         options.grid_name = opt->grid;
         options.background = opt->background;

@@ -72,12 +72,13 @@ RegisterCommand reg("info", "describe the grids of a .vdb file (bbox, voxel size
                     [](CLI::App& sub, CommonOptions& common) -> RunFunction {
                       auto opt = std::make_shared<InfoOptions>();
                       sub.add_option("VOLUME", opt->volume, "input .vdb (default: the scene's volume)");
-                      sub.add_option("--grid", opt->grid, "grid for the histogram (default: the first float grid)");
-                      sub.add_option("--bins", opt->bins, "histogram bins")->capture_default_str();
+                      sub.add_option("--grid", opt->grid, "grid for the histogram (default: the first float grid with active voxels, else the "
+                                     "first float grid)");
+                      sub.add_option("--bins", opt->bins, "histogram bins")->check(CLI::PositiveNumber)
+                          ->capture_default_str();
                       sub.footer("Examples:\n  raysift info datasets/engine_ct.vdb\n"
-                                 "  raysift info smoke.vdb --grid density --stats smoke_info.json");
+                                 "  raysift info smoke.vdb --grid density --stats smoke_info.json\n");
                       return [opt, &common] {
-                        if (opt->bins < 1) bad_flag("--bins", ">= 1", std::to_string(opt->bins));
                         std::string path = opt->volume, grid = opt->grid;
                         if (!common.scene_path.empty()) {
                           const Scene scene = load_scene(common.scene_path);
@@ -90,15 +91,8 @@ RegisterCommand reg("info", "describe the grids of a .vdb file (bbox, voxel size
                         const double read_ms = timer.elapsed_ms();
                         Json stats = {{"command", "info"}, {"file", path}, {"grids", Json::array()}};
                         for (const auto& g : grids) stats["grids"].push_back(grid_json(g));
-                        // The histogram needs a float grid: by default the first one with active voxels (else
-                        // the first one); files with no float grid still get their grid list.
-                        if (grid.empty()) {
-                          for (const auto& g : grids)
-                            if (g.type == "float" && (grid.empty() || g.active_voxels > 0)) {
-                              grid = g.name;
-                              if (g.active_voxels > 0) break;
-                            }
-                        }
+                        // Files with no float grid still get their grid list, without a histogram.
+                        if (grid.empty()) grid = volume::default_grid_name(grids);
                         volume::Histogram hist;
                         std::string hist_grid;
                         timer.reset();

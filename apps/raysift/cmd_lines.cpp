@@ -5,18 +5,14 @@
 #include <memory>
 #include <sstream>
 
+#include "apps/raysift/cli_checks.h"
 #include "apps/raysift/command.h"
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/image.h"
 #include "core/scene.h"
 #include "core/timer.h"
-#include "features/importance.h"
-#include "features/line_picture.h"
-#include "features/lines.h"
-#include "features/raster.h"
-#include "features/visibility.h"
-#include "mesh/curvature.h"
+#include "features/lines_pipeline.h"
 #include "mesh/mesh_io.h"
 #include "volume/vdb_io.h"
 
@@ -28,37 +24,10 @@ struct LinesCliOptions {
   std::string camera_path;
   std::string features = "all";
   std::string out, svg, importance;
-  int width = 0, height = 0;  ///< 0 = from the camera (default camera: 800x600)
+  int width = 0, height = 0;  ///< 0 = from the camera (default camera: CameraSpec's default size)
   std::string priorities;     ///< "class=value,..." overrides
-  features::LineOptions lines;
-  features::ImportanceOptions importance_options;
-  features::VisibilityOptions visibility;
-  features::PictureOptions picture;
+  features::LinesPipelineOptions lib;
 };
-
-std::string str(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
-/// [choice] Default view: from +z towards the bbox centre, up +y, fov_y 30 degrees, at the distance where
-/// the bounding sphere (half the bbox diagonal) fits the narrower field of view with a 10 % margin.
-CameraSpec fit_camera(const TriMesh& mesh, int width, int height) {
-  Bbox3d box;
-  for (const Vec3f& p : mesh.positions) box.expand(Vec3d(p));
-  CameraSpec c;
-  c.width = width;
-  c.height = height;
-  c.fov_y_deg = 30.0;
-  const double half_y = c.fov_y_deg * M_PI / 360.0;
-  const double half_min = std::min(half_y, std::atan(std::tan(half_y) * width / height));
-  const double radius = std::max(0.5 * box.diagonal(), 1e-12);
-  c.target = box.center();
-  c.eye = box.center() + Vec3d{0, 0, 1.1 * radius / std::sin(half_min)};
-  c.up = {0, 1, 0};
-  return c;
-}
 
 void apply_priorities(const std::string& table, std::array<float, features::kLineClassCount>& priority) {
   std::stringstream in(table);
@@ -84,175 +53,160 @@ void apply_priorities(const std::string& table, std::array<float, features::kLin
   }
 }
 
-void validate(const LinesCliOptions& o) {
-  if (file_extension(o.out) != ".png") bad_flag("-o/--out", "a .png file", o.out);
-  if (!o.svg.empty() && file_extension(o.svg) != ".svg") bad_flag("--svg", "a .svg file", o.svg);
-  if (!o.importance.empty() && file_extension(o.importance) != ".exr")
-    bad_flag("--importance", "a .exr file", o.importance);
-  if (o.width < 0 || o.width > kMaxImageSide) bad_flag("--width", "in 1.." + std::to_string(kMaxImageSide), str(o.width));
-  if (o.height < 0 || o.height > kMaxImageSide)
-    bad_flag("--height", "in 1.." + std::to_string(kMaxImageSide), str(o.height));
-  const auto& io = o.importance_options;
-  if (!(io.scale > 0 && io.scale <= 1)) bad_flag("--importance-scale", "in (0, 1]", str(io.scale));
-  if (!(io.falloff_px > 0)) bad_flag("--falloff-px", "> 0 (frame pixels)", str(io.falloff_px));
-  if (!(o.visibility.depth_tolerance >= 0 && o.visibility.depth_tolerance < 1))
-    bad_flag("--depth-tolerance", "in [0, 1) (fraction of depth)", str(o.visibility.depth_tolerance));
-  if (!(o.picture.line_width_px > 0 && o.picture.line_width_px <= 32))
-    bad_flag("--line-width", "in (0, 32] pixels", str(o.picture.line_width_px));
-  for (double t : {o.lines.suggestive_threshold, o.lines.highlight_threshold, o.lines.ridge_threshold})
-    if (!(t >= 0 && std::isfinite(t))) bad_flag("--sug-thresh/--sh-thresh/--rv-thresh", ">= 0", str(t));
+void add_options(CLI::App& sub, LinesCliOptions& o) {
+  features::LinesPipelineOptions& lib = o.lib;
+  sub.add_option("MESH_OR_SCENE", o.input, "mesh (.ply/.obj/.off) or scene .json (its mesh, camera, volume)");
+  auto* view = sub.add_option_group("View");
+  view->add_option("--camera", o.camera_path, "camera JSON (eye, target, up, fov_y_deg, width, height)");
+  view->add_option("--width", o.width, "image width, pixels (0 = the camera's; default camera " +
+                                           std::to_string(CameraSpec{}.width) + ")")
+      ->check(CLI::Range(0, kMaxImageSide))->capture_default_str();
+  view->add_option("--height", o.height, "image height, pixels (0 = the camera's; default camera " +
+                                             std::to_string(CameraSpec{}.height) + ")")
+      ->check(CLI::Range(0, kMaxImageSide))->capture_default_str();
+  auto* lines = sub.add_option_group("Lines");
+  lines->add_option("--features", o.features,
+                    "line classes: all or a list of contours,silhouettes,suggestive,highlights,ridges,valleys")
+      ->capture_default_str();
+  lines->add_option("--sug-thresh", lib.lines.suggestive_threshold, "suggestive-contour threshold (x 1/fs^2)")
+      ->check(number_in(0, INFINITY))->capture_default_str();
+  lines->add_option("--sh-thresh", lib.lines.highlight_threshold, "suggestive-highlight threshold (x 1/fs^2)")
+      ->check(number_in(0, INFINITY))->capture_default_str();
+  lines->add_option("--rv-thresh", lib.lines.ridge_threshold, "ridge/valley threshold (x 1/fs)")
+      ->check(number_in(0, INFINITY))->capture_default_str();
+  lines->add_option("--depth-tolerance", lib.visibility.depth_tolerance, "hidden-line depth tolerance, fraction of depth")
+      ->check(number_in(0, 1, End::Closed, End::Open))->capture_default_str();
+  lines->add_option("--line-width", lib.picture.line_width_px, "stroke width in the picture and SVG, pixels")
+      ->check(number_in(0, 32, End::Open))->capture_default_str();
+  auto* importance = sub.add_option_group("Importance");
+  importance->add_option("--importance-scale", lib.importance.scale, "importance buffer size / frame size")
+      ->check(number_in(0, 1, End::Open))->capture_default_str();
+  importance->add_option("--falloff-px", lib.importance.falloff_px, "importance fall-off radius around lines, frame pixels")
+      ->check(number_in(0, INFINITY, End::Open))->capture_default_str();
+  importance->add_option("--priority", o.priorities,
+                         "class priority overrides, e.g. contours=1,ridges=0.3 (defaults: contours, silhouettes 1.0; "
+                         "others 0.6)");
+  auto* output = sub.add_option_group("Output");
+  output->add_option("-o,--out", o.out, "picture of the lines over the shaded mesh (.png)")->required()
+      ->check(has_extension({".png"}));
+  output->add_option("--svg", o.svg, "visible lines as SVG")->check(has_extension({".svg"}));
+  output->add_option("--importance", o.importance, "importance buffer (.exr, float; background < 0)")
+      ->check(has_extension({".exr"}));
+  sub.footer(
+      "Without a camera the view looks from +z at the mesh's bounding-box centre (fov 30 degrees, the bounding "
+      "sphere in view).\n"
+      "Examples:\n"
+      "  raysift lines bunny.ply -o bunny_lines.png --svg bunny_lines.svg\n"
+      "  raysift lines engine.ply --camera cam.json --features contours,silhouettes,suggestive \\\n"
+      "      -o lines.png --importance importance.exr --stats lines.json\n");
+}
+
+/// The mesh path, the camera and the volume box from MESH_OR_SCENE, --scene and --camera.
+struct LinesInputs {
+  std::string mesh_path;
+  std::optional<CameraSpec> camera;
+  std::optional<Bbox3d> volume_box;
+};
+
+LinesInputs resolve_inputs(const LinesCliOptions& o, const CommonOptions& common) {
+  LinesInputs in{o.input, std::nullopt, std::nullopt};
+  const std::string scene_path = file_extension(o.input) == ".json" ? o.input : common.scene_path;
+  if (!scene_path.empty()) {
+    const Scene scene = load_scene(scene_path);
+    const bool mesh_from_scene = o.input.empty() || o.input == scene_path;
+    if (scene.mesh.empty() && mesh_from_scene)
+      throw InvalidInput(file_message(scene_path, "the scene names no 'mesh'; add one or pass a mesh file"));
+    if (mesh_from_scene) in.mesh_path = scene.mesh;
+    in.camera = scene.camera;
+    if (!scene.volume.empty()) {
+      const std::vector<volume::GridInfo> grids = volume::inspect_vdb(scene.volume);
+      const std::string grid = !scene.grid.empty() ? scene.grid : volume::default_grid_name(grids);
+      for (const volume::GridInfo& g : grids)
+        if (g.name == grid && g.type == "float" && g.active_voxels > 0) {
+          // Active voxel centres, grown by half a voxel to the voxels' extent.
+          in.volume_box = Bbox3d{g.bbox_min - g.voxel_size * 0.5, g.bbox_max + g.voxel_size * 0.5};
+          break;
+        }
+    }
+  }
+  if (in.mesh_path.empty()) throw UsageError("lines: give a mesh file or a scene (MESH_OR_SCENE); see --help");
+  if (!o.camera_path.empty()) in.camera = camera_spec_from_json(read_json_file(o.camera_path), o.camera_path);
+  return in;
+}
+
+Json stats_json(const std::string& mesh_path, const TriMesh& mesh, const CameraSpec& spec,
+                const features::LinesPipelineOptions& options, const features::LinesPipelineResult& r, double read_ms) {
+  Json segments = Json::object();
+  for (int c = 0; c < features::kLineClassCount; ++c)
+    if (options.classes.has(features::LineClass(c)))
+      segments[features::line_class_name(features::LineClass(c))] = r.visible.count(features::LineClass(c));
+  const mesh::MeshCurvature& k = r.curvature;
+  Json stats;
+  stats["command"] = "lines";
+  stats["mesh"] = mesh_path;
+  stats["camera"] = camera_spec_to_json(spec);
+  stats["segments"] = segments;
+  stats["segments_extracted"] = r.extracted.segments.size();
+  stats["feature_size"] = k.feature_size;
+  stats["mesh_report"] = {{"triangles", mesh.triangle_count()},
+                          {"degenerate_faces", k.degenerate_faces},
+                          {"boundary_vertices", k.boundary_vertices},
+                          {"nonmanifold_vertices", k.nonmanifold_vertices},
+                          {"unreferenced_vertices", k.unreferenced_vertices}};
+  if (r.importance) stats["importance_size"] = {r.importance->values.width, r.importance->values.height};
+  stats["times_ms"] = {{"read", read_ms},
+                       {"curvature", r.times_ms.curvature},
+                       {"lines", r.times_ms.lines},
+                       {"visibility", r.times_ms.visibility},
+                       {"raster", r.times_ms.raster}};
+  return stats;
 }
 
 RegisterCommand reg(
     "lines", "DeCarlo feature lines of a mesh (picture, SVG) and the object-space importance buffer",
     [](CLI::App& sub, CommonOptions& common) -> RunFunction {
       auto opt = std::make_shared<LinesCliOptions>();
-      sub.add_option("MESH_OR_SCENE", opt->input, "mesh (.ply/.obj/.off) or scene .json (its mesh, camera, volume)");
-      sub.add_option("--camera", opt->camera_path, "camera JSON (eye, target, up, fov_y_deg, width, height)");
-      sub.add_option("--features", opt->features,
-                     "line classes: all or a list of contours,silhouettes,suggestive,highlights,ridges,valleys")
-          ->capture_default_str();
-      sub.add_option("-o,--out", opt->out, "picture of the lines over the shaded mesh (.png)")->required();
-      sub.add_option("--svg", opt->svg, "visible lines as SVG");
-      sub.add_option("--importance", opt->importance, "importance buffer (.exr, float; background < 0)");
-      sub.add_option("--width", opt->width, "image width, pixels (0 = camera's, default camera 800)");
-      sub.add_option("--height", opt->height, "image height, pixels (0 = camera's, default camera 600)");
-      sub.add_option("--importance-scale", opt->importance_options.scale, "importance buffer size / frame size")
-          ->capture_default_str();
-      sub.add_option("--falloff-px", opt->importance_options.falloff_px,
-                     "importance fall-off radius around lines, frame pixels")->capture_default_str();
-      sub.add_option("--priority", opt->priorities,
-                     "class priority overrides, e.g. contours=1,ridges=0.3 (defaults: contours, silhouettes 1.0; "
-                     "others 0.6)");
-      sub.add_option("--sug-thresh", opt->lines.suggestive_threshold, "suggestive-contour threshold (x 1/fs^2)")
-          ->capture_default_str();
-      sub.add_option("--sh-thresh", opt->lines.highlight_threshold, "suggestive-highlight threshold (x 1/fs^2)")
-          ->capture_default_str();
-      sub.add_option("--rv-thresh", opt->lines.ridge_threshold, "ridge/valley threshold (x 1/fs)")
-          ->capture_default_str();
-      sub.add_option("--depth-tolerance", opt->visibility.depth_tolerance,
-                     "hidden-line depth tolerance, fraction of depth")->capture_default_str();
-      sub.add_option("--line-width", opt->picture.line_width_px, "stroke width in the picture and SVG, pixels")
-          ->capture_default_str();
-      sub.footer(
-          "Without a camera the view looks from +z at the mesh's bounding-box centre (fov 30 degrees, whole mesh "
-          "in view).\n"
-          "Examples:\n"
-          "  raysift lines bunny.ply -o bunny_lines.png --svg bunny_lines.svg\n"
-          "  raysift lines engine.ply --camera cam.json --features contours,silhouettes,suggestive \\\n"
-          "      -o lines.png --importance importance.exr --stats lines.json");
+      add_options(sub, *opt);
       return [opt, &common] {
-        validate(*opt);
-        features::LineClassSet classes;
+        features::LinesPipelineOptions& lib = opt->lib;
         try {
-          classes = features::parse_line_classes(opt->features);
+          lib.classes = features::parse_line_classes(opt->features);
         } catch (const InvalidInput& e) {
           throw UsageError(std::string("--features: ") + e.what() + "; see --help");
         }
-        apply_priorities(opt->priorities, opt->importance_options.priority);
-        opt->lines.classes = classes;
-        opt->visibility.classes = classes;
-        const bool threaded = common.threads != 1;
-        opt->lines.threaded = opt->visibility.threaded = opt->importance_options.threaded = threaded;
-        opt->picture.threaded = threaded;
+        apply_priorities(opt->priorities, lib.importance.priority);
+        lib.threaded = common.threads != 1;
+        lib.with_importance = !opt->importance.empty();
 
-        // Inputs: a mesh, or a scene naming the mesh (and optionally the camera and the volume).
-        std::string mesh_path = opt->input;
-        std::optional<CameraSpec> camera;
-        std::optional<Bbox3d> volume_box;
-        std::string scene_path = common.scene_path;
-        if (file_extension(opt->input) == ".json") scene_path = opt->input;
-        if (!scene_path.empty()) {
-          const Scene scene = load_scene(scene_path);
-          if (scene.mesh.empty() && (opt->input.empty() || opt->input == scene_path))
-            throw InvalidInput(file_message(scene_path, "the scene names no 'mesh'; add one or pass a mesh file"));
-          if (opt->input.empty() || opt->input == scene_path) mesh_path = scene.mesh;
-          camera = scene.camera;
-          if (!scene.volume.empty()) {
-            for (const volume::GridInfo& g : volume::inspect_vdb(scene.volume)) {
-              if ((!scene.grid.empty() && g.name != scene.grid) || g.type != "float" || g.active_voxels == 0) continue;
-              // Active voxel centres, grown by half a voxel to the voxels' extent.
-              volume_box = Bbox3d{g.bbox_min - g.voxel_size * 0.5, g.bbox_max + g.voxel_size * 0.5};
-              break;
-            }
-          }
-        }
-        if (mesh_path.empty()) throw UsageError("lines: give a mesh file or a scene (MESH_OR_SCENE); see --help");
-        if (!opt->camera_path.empty())
-          camera = camera_spec_from_json(read_json_file(opt->camera_path), opt->camera_path);
-
+        const LinesInputs in = resolve_inputs(*opt, common);
+        lib.background_box_ws = in.volume_box;
         Timer timer;
-        const TriMesh mesh = mesh::read_mesh(mesh_path);
+        const TriMesh mesh = mesh::read_mesh(in.mesh_path);
         const double read_ms = timer.elapsed_ms();
-        CameraSpec spec = camera ? *camera : fit_camera(mesh, 800, 600);
+        CameraSpec spec = in.camera ? *in.camera : features::fit_camera_to_mesh(mesh);
         if (opt->width > 0) spec.width = opt->width;
         if (opt->height > 0) spec.height = opt->height;
         const Camera cam(spec);
 
-        timer.reset();
-        mesh::MeshCurvature curvature;
+        features::LinesPipelineResult r;
         try {
-          curvature = mesh::compute_curvature(mesh, {threaded});
+          r = features::run_lines_pipeline(mesh, cam, lib);
         } catch (const InvalidInput& e) {
-          throw InvalidInput(file_message(mesh_path, e.what()));
+          throw InvalidInput(file_message(in.mesh_path, e.what()));
         }
-        const double curvature_ms = timer.elapsed_ms();
-        if (!common.quiet && (curvature.nonmanifold_vertices > 0 || curvature.degenerate_faces > 0))
-          std::cerr << "raysift lines: note: " << mesh_path << ": skipped " << curvature.nonmanifold_vertices
-                    << " non-manifold vertices and " << curvature.degenerate_faces << " zero-area faces\n";
-
-        timer.reset();
-        const features::FeatureLines lines = features::extract_lines(mesh, curvature, cam.eye(), opt->lines);
-        const double lines_ms = timer.elapsed_ms();
-
-        timer.reset();
-        const features::DepthBuffer depth = features::rasterize_depth(mesh, cam, {threaded});
-        const features::FeatureLines visible = features::remove_hidden_lines(lines, depth, opt->visibility);
-        const double visibility_ms = timer.elapsed_ms();
-
-        timer.reset();
-        const ImageRGBA picture = features::render_line_picture(mesh, depth, visible, opt->picture);
-        std::optional<features::ImportanceBuffer> importance;
-        if (!opt->importance.empty()) {
-          features::BackgroundGeometry bg;
-          bg.mesh = &mesh;
-          bg.bbox_ws = volume_box;
-          importance = features::rasterize_importance(visible, cam, bg, opt->importance_options);
-        }
-        const double raster_ms = timer.elapsed_ms();
-
-        write_image(opt->out, picture);
-        if (!opt->svg.empty()) features::write_lines_svg(opt->svg, visible, cam, opt->picture.line_width_px);
-        if (importance) write_image(opt->importance, importance->values);
-
-        Json segments = Json::object();
-        for (int c = 0; c < features::kLineClassCount; ++c)
-          if (classes.has(features::LineClass(c)))
-            segments[features::line_class_name(features::LineClass(c))] = visible.count(features::LineClass(c));
+        const mesh::MeshCurvature& k = r.curvature;
+        if (!common.quiet && (k.nonmanifold_vertices > 0 || k.degenerate_faces > 0))
+          std::cerr << "raysift lines: note: " << in.mesh_path << ": skipped " << k.nonmanifold_vertices
+                    << " non-manifold vertices and " << k.degenerate_faces << " zero-area faces\n";
+        write_image(opt->out, r.picture);
+        if (!opt->svg.empty()) features::write_lines_svg(opt->svg, r.visible, cam, lib.picture.line_width_px);
+        if (r.importance) write_image(opt->importance, r.importance->values);
         if (common.verbose)
-          std::cerr << "lines: " << mesh.triangle_count() << " triangles, " << lines.segments.size()
-                    << " segments, " << visible.segments.size() << " visible pieces; curvature " << curvature_ms
-                    << " ms, lines " << lines_ms << " ms, visibility " << visibility_ms << " ms, raster " << raster_ms
-                    << " ms\n";
-        Json stats;
-        stats["command"] = "lines";
-        stats["mesh"] = mesh_path;
-        stats["camera"] = camera_spec_to_json(spec);
-        stats["segments"] = segments;
-        stats["segments_extracted"] = lines.segments.size();
-        stats["feature_size"] = curvature.feature_size;
-        stats["mesh_report"] = {{"triangles", mesh.triangle_count()},
-                                {"degenerate_faces", curvature.degenerate_faces},
-                                {"boundary_vertices", curvature.boundary_vertices},
-                                {"nonmanifold_vertices", curvature.nonmanifold_vertices},
-                                {"unreferenced_vertices", curvature.unreferenced_vertices}};
-        if (importance) stats["importance_size"] = {importance->values.width, importance->values.height};
-        stats["times_ms"] = {{"read", read_ms},
-                             {"curvature", curvature_ms},
-                             {"lines", lines_ms},
-                             {"visibility", visibility_ms},
-                             {"raster", raster_ms}};
-        write_stats_if_requested(common, stats);
+          std::cerr << "lines: " << mesh.triangle_count() << " triangles, " << r.extracted.segments.size()
+                    << " segments, " << r.visible.segments.size() << " visible pieces; curvature "
+                    << r.times_ms.curvature << " ms, lines " << r.times_ms.lines << " ms, visibility "
+                    << r.times_ms.visibility << " ms, raster " << r.times_ms.raster << " ms\n";
+        write_stats_if_requested(common, stats_json(in.mesh_path, mesh, spec, lib, r, read_ms));
       };
     });
 

@@ -2,6 +2,7 @@
 #include <iostream>
 #include <memory>
 
+#include "apps/raysift/cli_checks.h"
 #include "apps/raysift/command.h"
 #include "core/errors.h"
 #include "core/file_util.h"
@@ -25,30 +26,22 @@ std::string views_path_for(const std::string& mesh_path) {
 
 RegisterCommand reg(
     "make-scene",
-    "write a procedural scene for multi-view sampling (blocks4, grass, urban) and its views file\n"
-    "Examples:\n"
-    "  raysift make-scene blocks4 -o blocks4.ply      # also writes blocks4.views.json\n"
-    "  raysift make-scene grass --seed 3 --triangles 20002 -o grass.ply",
+    "write a procedural scene for multi-view sampling (blocks4, grass, urban) and its views file",
     [](CLI::App& sub, CommonOptions& common) -> RunFunction {
       auto opt = std::make_shared<MakeSceneCliOptions>();
-      sub.add_option("KIND", opt->kind, "blocks4 | grass | urban")->required();
+      sub.footer("Examples:\n"
+                 "  raysift make-scene blocks4 -o blocks4.ply      # also writes blocks4.views.json\n"
+                 "  raysift make-scene grass --seed 3 --triangles 20002 -o grass.ply\n");
+      sub.add_option("KIND", opt->kind, "scene kind")->required()->check(CLI::IsMember({"blocks4", "grass", "urban"}));
       sub.add_option("-o,--out", opt->out, "output mesh .ply/.obj/.off; the views go to <stem>.views.json")
-          ->required();
+          ->required()->check(has_extension({".ply", ".obj", ".off"}));
       sub.add_option("--triangles", opt->triangles,
                      "target triangle count for grass/urban (0 = default: grass 56000, urban 50000)")
           ->capture_default_str();
       return [opt, &common] {
-        nrr::SceneKind kind;
-        try {
-          kind = nrr::parse_scene_kind(opt->kind);
-        } catch (const InvalidInput&) {
-          bad_flag("KIND", "one of blocks4, grass, urban", "'" + opt->kind + "'");
-        }
+        const nrr::SceneKind kind = nrr::parse_scene_kind(opt->kind);  // checked by CLI11
         if (opt->triangles != 0 && opt->triangles < 100)
           bad_flag("--triangles", "0 or >= 100", std::to_string(opt->triangles));
-        const std::string ext = file_extension(opt->out);
-        if (ext != ".ply" && ext != ".obj" && ext != ".off")
-          bad_flag("-o/--out", "a .ply, .obj or .off path", "'" + opt->out + "'");
         Timer timer;
         nrr::SceneOptions so;
         so.seed = common.seed;

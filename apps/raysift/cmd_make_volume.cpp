@@ -123,7 +123,7 @@ RegisterCommand reg(
           "Blobs use --seed. Examples:\n"
           "  raysift make-volume ball --dims 64,64,64 --radius 24 -o ball.vdb\n"
           "  raysift make-volume torus --major-radius 20 --minor-radius 6 -o torus.vdb\n"
-          "  raysift make-volume blobs --count 12 --sigma 5 --seed 3 -o blobs.vdb");
+          "  raysift make-volume blobs --count 12 --sigma 5 --seed 3 -o blobs.vdb\n");
       CLI::App* app = &sub;
       return [opt, app, &common] {
         const auto it = kinds().find(opt->kind);

@@ -2,9 +2,11 @@
 // library's iso-surface pipeline (isosurface/pipeline.h) -> write all surfaces into one mesh file -> stats.
 #include <cmath>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <sstream>
 
+#include "apps/raysift/cli_checks.h"
 #include "apps/raysift/command.h"
 #include "apps/raysift/volume_input.h"
 #include "core/errors.h"
@@ -21,7 +23,8 @@ namespace raysift::app {
 namespace {
 
 struct MeshCliOptions {
-  std::string volume, grid, tf, out, iso;
+  std::string volume, grid, tf, out;
+  std::vector<double> iso;  ///< empty = the TF chooses
   bool tf_normalized = false;
   int max_surfaces = volume::IsoValueOptions{}.max_surfaces;
   int smooth = mesh::SmoothingOptions{}.iterations;
@@ -35,38 +38,9 @@ struct MeshCliOptions {
   bool unguarded = false;
 };
 
-std::vector<double> parse_iso_list(const std::string& text) {
-  std::vector<double> values;
-  std::stringstream s(text);
-  std::string item;
-  while (std::getline(s, item, ',')) {
-    double v = NAN;
-    try {
-      std::size_t used = 0;
-      v = std::stod(item, &used);
-      if (used != item.size()) v = NAN;
-    } catch (const std::exception&) {
-    }
-    if (!std::isfinite(v)) bad_flag("--iso", "a comma-separated list of finite numbers", text);
-    values.push_back(v);
-  }
-  if (values.empty()) bad_flag("--iso", "a comma-separated list of finite numbers", text);
-  return values;
-}
-
-void validate(const MeshCliOptions& o, CLI::App& sub) {
-  const std::string ext = file_extension(o.out);
-  if (ext != ".ply" && ext != ".obj" && ext != ".off") bad_flag("-o/--out", "a .ply, .obj or .off path", o.out);
-  if (o.max_surfaces < 1) bad_flag("--max-surfaces", ">= 1", std::to_string(o.max_surfaces));
-  if (o.smooth < 0) bad_flag("--smooth", ">= 0 iterations (0 = off)", std::to_string(o.smooth));
-  if (!(o.lambda > 0 && o.lambda <= 1)) bad_flag("--lambda", "in (0, 1]", std::to_string(o.lambda));
-  if (!(o.mu < -o.lambda && o.mu >= -1))
-    bad_flag("--mu", "in [-1, -lambda) (Taubin inflation step)", std::to_string(o.mu));
-  if (!(o.decimate > 0 && o.decimate <= 1)) bad_flag("--decimate", "a face ratio in (0, 1] (1 = off)", std::to_string(o.decimate));
-  if (sub.count("--decimate") && sub.count("--faces")) throw UsageError("--decimate and --faces are exclusive; see --help");
-  if (o.faces < 0 || (sub.count("--faces") && o.faces < 4)) bad_flag("--faces", ">= 4", std::to_string(o.faces));
-  if (!(o.max_error >= 0) || !std::isfinite(o.max_error))
-    bad_flag("--max-error", ">= 0 world units (0 = unbounded)", std::to_string(o.max_error));
+/// The one cross-flag rule CLI11's validators cannot state.
+void validate(const MeshCliOptions& o) {
+  if (!(o.mu < -o.lambda)) bad_flag("--mu", "in [-1, -lambda) (Taubin inflation step)", std::to_string(o.mu));
 }
 
 Json stage_json(const mesh::StageReport& s) { return {{"ms", s.ms}, {"triangles", s.triangles}}; }
@@ -92,7 +66,7 @@ std::string echo_command(const MeshCliOptions& o, const std::vector<double>& iso
 std::vector<double> given_iso_values(const MeshCliOptions& o, const volume::GridInfo& info) {
   std::vector<double> values;
   if (o.iso.empty()) return values;
-  for (const double v : parse_iso_list(o.iso)) {
+  for (const double v : o.iso) {
     if (v < info.value_min || v > info.value_max) {
       std::ostringstream range;
       range << "within the data range [" << info.value_min << ", " << info.value_max << "] of grid '" << info.name << "'";
@@ -139,8 +113,8 @@ Json stages_json(const isosurface::StageTimes& t) {
           {"smooth_after", stage_json(t.smooth_after)}};
 }
 
-void run(const MeshCliOptions& o, const CommonOptions& common, CLI::App& sub) {
-  validate(o, sub);
+void run(const MeshCliOptions& o, const CommonOptions& common) {
+  validate(o);
   VolumeInput input = load_volume_input(o.volume, o.grid, o.tf, o.tf_normalized, common.scene_path, "mesh");
   if (!input.tf && o.iso.empty())
     throw UsageError("mesh needs --tf TF.json (or a --scene with a 'transfer_function') or --iso; see --help");
@@ -184,32 +158,40 @@ RegisterCommand reg(
     [](CLI::App& sub, CommonOptions& common) -> RunFunction {
       auto opt = std::make_shared<MeshCliOptions>();
       sub.add_option("VOLUME", opt->volume, "input .vdb (default: the scene's volume)");
-      sub.add_option("-o,--out", opt->out, "output mesh (.ply binary, .obj, .off); all surfaces in one file")->required();
-      sub.add_option("--grid", opt->grid, "grid name (default: the scene's, else the first float grid)");
+      sub.add_option("-o,--out", opt->out, "output mesh (.ply binary, .obj, .off); all surfaces in one file")
+          ->required()->check(has_extension({".ply", ".obj", ".off"}));
+      sub.add_option("--grid", opt->grid, "grid name (default: the scene's, else the first non-empty float grid)");
       sub.add_option("--tf", opt->tf, "transfer function JSON; picks the iso-values (see docs/isosurface.md)");
       sub.add_flag("--tf-normalized", opt->tf_normalized, "TF x values are 0..1 over the data range");
-      sub.add_option("--iso", opt->iso, "iso-values V1,V2,... (overrides the TF's choice)");
-      sub.add_option("--max-surfaces", opt->max_surfaces, "at most this many TF-chosen iso-values, >= 1")
+      auto* iso = sub.add_option_group("Iso-values");
+      iso->add_option("--iso", opt->iso, "iso-values V1,V2,... (overrides the TF's choice)")->delimiter(',')
+          ->check(number_in(-INFINITY, INFINITY));
+      iso->add_option("--max-surfaces", opt->max_surfaces, "at most this many TF-chosen iso-values")
+          ->check(CLI::PositiveNumber)->capture_default_str();
+      auto* smooth = sub.add_option_group("Smoothing");
+      smooth->add_option("--smooth", opt->smooth, "Taubin iterations before and after decimation (0 = off)")
+          ->check(CLI::NonNegativeNumber)->capture_default_str();
+      smooth->add_option("--lambda", opt->lambda, "Taubin shrink step")->check(number_in(0, 1, End::Open))
           ->capture_default_str();
-      sub.add_option("--smooth", opt->smooth, "Taubin iterations before and after decimation, >= 0 (0 = off)")
+      smooth->add_option("--mu", opt->mu, "Taubin inflate step, [-1, -lambda)")->check(number_in(-1, 0, End::Closed, End::Open))
           ->capture_default_str();
-      sub.add_option("--lambda", opt->lambda, "Taubin shrink step, (0, 1]")->capture_default_str();
-      sub.add_option("--mu", opt->mu, "Taubin inflate step, [-1, -lambda)")->capture_default_str();
-      sub.add_flag("--cotangent", opt->cotangent, "cotangent instead of uniform smoothing weights");
-      sub.add_option("--decimate", opt->decimate, "keep this fraction of the faces, (0, 1] (1 = off)")
-          ->capture_default_str();
-      sub.add_option("--faces", opt->faces, "total face target instead of --decimate, split over the surfaces");
-      sub.add_option("--max-error", opt->max_error,
-                     "decimation distance bound in world units (0 = unbounded)")->capture_default_str();
-      sub.add_flag("--flip", opt->flip, "normals toward increasing values (default: toward decreasing)");
-      sub.add_flag("--unguarded", opt->unguarded,
+      smooth->add_flag("--cotangent", opt->cotangent, "cotangent instead of uniform smoothing weights");
+      auto* decimation = sub.add_option_group("Decimation");
+      CLI::Option* ratio = decimation->add_option("--decimate", opt->decimate, "keep this fraction of the faces (1 = off)")
+                               ->check(number_in(0, 1, End::Open))->capture_default_str();
+      decimation->add_option("--faces", opt->faces, "total face target instead of --decimate, split over the surfaces")
+          ->check(CLI::Range(4LL, std::numeric_limits<long long>::max()))->excludes(ratio);
+      decimation->add_option("--max-error", opt->max_error, "decimation distance bound in world units (0 = unbounded)")
+          ->check(number_in(0, INFINITY))->capture_default_str();
+      iso->add_flag("--flip", opt->flip, "normals toward increasing values (default: toward decreasing)");
+      decimation->add_flag("--unguarded", opt->unguarded,
                    "simplify with one meshoptimizer run instead of the topology-safe quadric collapse: 2-4x faster, "
                    "but the result may have non-manifold edges and closed handles");
       sub.footer(
           "Examples:\n"
           "  raysift mesh engine.vdb --tf engine_tf.json -o engine.ply --stats mesh_stats.json\n"
-          "  raysift mesh engine.vdb --iso 80.5,150.5 --smooth 20 --faces 100000 -o engine.obj");
-      return [opt, &common, &sub] { run(*opt, common, sub); };
+          "  raysift mesh engine.vdb --iso 80.5,150.5 --smooth 20 --faces 100000 -o engine.obj\n");
+      return [opt, &common] { run(*opt, common); };
     });
 
 }  // namespace

@@ -1,59 +1,56 @@
 // raysift nrr: multi-view depth images of a mesh (conventional, non-redundant, depth peeling) and the
-// sampling-quality metrics of Xie, Wang & Popescu 2016 §6.1.2.
+// sampling-quality metrics of Xie, Wang & Popescu 2016 §6.1.2; maps the flags onto nrr/nrr_pipeline.h.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <sstream>
 
+#include "apps/raysift/cli_checks.h"
 #include "apps/raysift/command.h"
 #include "core/errors.h"
 #include "core/timer.h"
 #include "mesh/mesh_io.h"
-#include "nrr/metrics.h"
-#include "nrr/sampler.h"
-#include "nrr/views.h"
+#include "nrr/nrr_pipeline.h"
 
 namespace raysift::app {
 namespace {
 
 struct NrrCliOptions {
-  std::string mesh, out_dir, mode = "nrr-pixel", views_file, region, eyes, target, up = "0,1,0";
-  std::string redundancy = "pixel";
+  std::string mesh, out_dir, views_file, eyes;
+  std::string region;
+  std::vector<double> target, up{0, 1, 0};
   double fov_y_deg = 45.0;
   int resolution = 1024;
-  int intermediate = 1000;
-  int layers = 0;
   bool skip_metrics = false;
+  nrr::NrrPipelineOptions lib;
 };
 
-Vec3d parse_vec3(const std::string& text, const std::string& flag) {
-  std::istringstream in(text);
-  Vec3d v;
-  char c1 = 0, c2 = 0;
-  if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || !(in >> std::ws).eof() || !is_finite(v))
-    bad_flag(flag, "three finite numbers x,y,z", "'" + text + "'");
-  return v;
-}
+const std::map<std::string, nrr::SamplingMode> kModes = {{"conventional", nrr::SamplingMode::Conventional},
+                                                         {"nrr-pixel", nrr::SamplingMode::NrrPixel},
+                                                         {"nrr-visibility", nrr::SamplingMode::NrrVisibility},
+                                                         {"peel", nrr::SamplingMode::Peel}};
+const std::map<std::string, nrr::Redundancy> kRedundancies = {{"pixel", nrr::Redundancy::Pixel},
+                                                              {"visibility", nrr::Redundancy::Visibility}};
 
+Vec3d vec3(const std::vector<double>& v) { return {v[0], v[1], v[2]}; }
+
+/// "x,y,z;x,y,z[;...]" -> eyes; exit 2 naming --eyes for a malformed entry.
 std::vector<Vec3d> parse_eyes(const std::string& text) {
   std::vector<Vec3d> eyes;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    const std::size_t end = std::min(text.find(';', start), text.size());
-    eyes.push_back(parse_vec3(text.substr(start, end - start), "--eyes"));
-    start = end + 1;
+  std::stringstream items(text);
+  std::string item;
+  while (std::getline(items, item, ';')) {
+    std::istringstream in(item);
+    Vec3d v;
+    char c1 = 0, c2 = 0;
+    if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || !(in >> std::ws).eof() || !is_finite(v))
+      bad_flag("--eyes", "three finite numbers x,y,z per eye", "'" + item + "'");
+    eyes.push_back(v);
   }
   return eyes;
-}
-
-/// Mean triangle edge over the size of one pixel at the scene centre seen from view 0: the ratio that
-/// decides how often pixel redundancy can fire (ALGORITHMS.md §10).
-double triangle_pixel_ratio(const nrr::SampledScene& scene, const CameraSpec& view) {
-  const double distance = length(scene.rays().bounds().center() - view.eye);
-  const double pixel = 2.0 * distance * std::tan(view.fov_y_deg * M_PI / 360.0) / view.height;
-  return pixel > 0.0 ? scene.mean_edge_length() / pixel : 0.0;
 }
 
 nrr::ViewSet views_from_options(const NrrCliOptions& o) {
@@ -63,22 +60,16 @@ nrr::ViewSet views_from_options(const NrrCliOptions& o) {
   if (!o.views_file.empty()) {
     set = nrr::read_views_file(o.views_file);
   } else {
-    nrr::ViewRegion region;
-    try {
-      region = nrr::parse_view_region(o.region);
-    } catch (const InvalidInput&) {
-      bad_flag("--view-region", "one of segment, triangle, rectangle", "'" + o.region + "'");
-    }
+    const nrr::ViewRegion region = nrr::parse_view_region(o.region);  // checked by CLI11
     if (o.eyes.empty() || o.target.empty())
       throw UsageError("--view-region needs --eyes \"x,y,z;x,y,z...\" and --target x,y,z; see --help");
     const std::vector<Vec3d> eyes = parse_eyes(o.eyes);
     if (int(eyes.size()) != nrr::corner_count(region))
       bad_flag("--eyes", std::to_string(nrr::corner_count(region)) + " eyes for a " + o.region,
                std::to_string(eyes.size()) + " eyes");
-    if (!(o.fov_y_deg > 0.0 && o.fov_y_deg < 180.0)) bad_flag("--fov-y-deg", "in (0, 180)", std::to_string(o.fov_y_deg));
     CameraSpec common;
-    common.target = parse_vec3(o.target, "--target");
-    common.up = parse_vec3(o.up, "--up");
+    common.target = vec3(o.target);
+    common.up = vec3(o.up);
     common.fov_y_deg = o.fov_y_deg;
     set.views = nrr::region_views(region, Span<const Vec3d>(eyes), common);
   }
@@ -91,143 +82,126 @@ Json image_json(const nrr::ImageMetrics& m) {
   return {{"samples", m.samples}, {"redundant", m.redundant}, {"disoccluded", m.disoccluded}, {"useful", m.useful}};
 }
 
+void add_options(CLI::App& sub, NrrCliOptions& o) {
+  sub.add_option("MESH", o.mesh, "input mesh .ply/.obj/.off")->required();
+  add_choice(sub, "--mode", o.lib.sampling.mode, kModes, "sampling method");
+  auto* views = sub.add_option_group("Views");
+  views->add_option("--views", o.views_file,
+                    "views JSON: a list of cameras, or {\"views\": [...], \"intermediate_views\": [...]}");
+  views->add_option("--view-region", o.region, "eyes' region (with --eyes, --target)")
+      ->check(CLI::IsMember({"segment", "triangle", "rectangle"}));
+  views->add_option("--eyes", o.eyes, "corner eyes \"x,y,z;x,y,z[;...]\" (2, 3 or 4, rectangle in perimeter order)");
+  views->add_option("--target", o.target, "common look-at point x,y,z for --view-region")->delimiter(',')->expected(3)
+      ->check(number_in(-INFINITY, INFINITY));
+  views->add_option("--up", o.up, "common up vector for --view-region")->delimiter(',')->expected(3)
+      ->check(number_in(-INFINITY, INFINITY))->capture_default_str();
+  views->add_option("--fov-y-deg", o.fov_y_deg, "vertical field of view for --view-region, degrees")
+      ->check(number_in(0, 180, End::Open, End::Open))->capture_default_str();
+  views->add_option("--resolution", o.resolution, "image side in pixels for every view")->check(image_side())
+      ->capture_default_str();
+  auto* metrics = sub.add_option_group("Metrics");
+  metrics->add_option("--intermediate-views", o.lib.intermediate_views,
+                      "number of intermediate frames for metrics (3) and (4), spread over the eyes' region")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  add_choice(*metrics, "--redundancy", o.lib.metrics.redundancy, kRedundancies, "redundancy used by the metrics");
+  metrics->add_option("--layers", o.lib.sampling.peel_layers, "peel only: number of layers (0 = one per view)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  metrics->add_flag("--no-metrics", o.skip_metrics, "only render the images");
+  sub.add_option("-o,--out", o.out_dir,
+                 "output folder: image_<i>.exr (+ .png preview) and image_<i>_samples.png (Fig. 6 colours)");
+  sub.footer(
+      "Examples:\n"
+      "  raysift make-scene blocks4 -o b4.ply && raysift nrr b4.ply --views b4.views.json --mode nrr-pixel -o out\n"
+      "  raysift nrr grass.ply --view-region triangle --eyes \"-2.5,2.5,7;2.5,2.5,7;0,4.5,6\" --target 0,0.3,0 \\\n"
+      "      --mode peel --resolution 512 --intermediate-views 200 --stats s.json\n");
+}
+
+Json stats_json(const NrrCliOptions& o, const nrr::SampledScene& scene, const nrr::ViewSet& views,
+                const nrr::NrrPipelineResult& r, double load_ms) {
+  const nrr::SamplingMetrics& m = r.metrics;
+  Json stats = {{"mesh", o.mesh},
+                {"mode", nrr::to_string(o.lib.sampling.mode)},
+                {"redundancy", nrr::to_string(o.lib.metrics.redundancy)},
+                {"resolution", o.resolution},
+                {"views", views.views.size()},
+                {"triangles", scene.rays().triangle_count()},
+                {"degenerate_triangles", scene.rays().degenerate_triangle_count()},
+                {"triangle_pixel_ratio", r.triangle_pixel_ratio},
+                {"images", Json::array()}};
+  if (o.skip_metrics) {
+    for (const nrr::DepthImage& im : r.images) stats["images"].push_back({{"samples", im.sample_count()}});
+  } else {
+    stats["intermediate_views"] = r.intermediate_view_count;
+    for (const nrr::ImageMetrics& im : m.images) stats["images"].push_back(image_json(im));
+    stats["view_dependent"] = {{"available_avg_pct", m.available_avg_pct},
+                               {"available_min_pct", m.available_min_pct},
+                               {"frames_with_samples", m.frames_with_samples}};
+  }
+  stats["times_ms"] = {{"load", load_ms}, {"render", r.render_ms}, {"metrics", r.metrics_ms}};
+  return stats;
+}
+
+void print_summary(const NrrCliOptions& o, const nrr::NrrPipelineResult& r) {
+  std::printf("raysift nrr: %s, %zu images of %dx%d, render %.1f ms, metrics %.1f ms\n",
+              nrr::to_string(o.lib.sampling.mode).c_str(), r.images.size(), o.resolution, o.resolution, r.render_ms,
+              r.metrics_ms);
+  for (std::size_t i = 0; i < r.images.size(); ++i) {
+    if (o.skip_metrics) {
+      std::printf("  image %zu: %zu samples\n", i, r.images[i].sample_count());
+      continue;
+    }
+    const nrr::ImageMetrics& im = r.metrics.images[i];
+    std::printf("  image %zu: %zu samples, %zu redundant, %zu disoccluded (%zu useful)\n", i, im.samples, im.redundant,
+                im.disoccluded, im.useful);
+  }
+  if (!o.skip_metrics)
+    std::printf("  intermediate frames: available avg %.2f%%, min %.2f%% (%s redundancy)\n", r.metrics.available_avg_pct,
+                r.metrics.available_min_pct, nrr::to_string(o.lib.metrics.redundancy).c_str());
+}
+
+void write_images(const std::string& out_dir, const nrr::NrrPipelineResult& r, bool with_metrics) {
+  const std::filesystem::path dir(out_dir);
+  std::filesystem::create_directories(dir);  // only now: a failed run leaves no folder behind
+  for (std::size_t i = 0; i < r.images.size(); ++i) {
+    const std::string stem = (dir / ("image_" + std::to_string(i))).string();
+    nrr::write_depth_image(r.images[i], stem + ".exr", stem + ".png");
+    if (with_metrics) write_image(stem + "_samples.png", nrr::sample_class_image(r.images[i], r.metrics.sample_classes[i]));
+  }
+}
+
 RegisterCommand reg(
-    "nrr",
-    "sample a mesh with multi-view depth images (conventional, non-redundant, depth peeling) and measure them\n"
-    "Examples:\n"
-    "  raysift make-scene blocks4 -o b4.ply && raysift nrr b4.ply --views b4.views.json --mode nrr-pixel -o out\n"
-    "  raysift nrr grass.ply --view-region triangle --eyes \"-2.5,2.5,7;2.5,2.5,7;0,4.5,6\" --target 0,0.3,0 \\\n"
-    "      --mode peel --resolution 512 --intermediate-views 200 --stats s.json",
+    "nrr", "sample a mesh with multi-view depth images (conventional, non-redundant, depth peeling) and measure them",
     [](CLI::App& sub, CommonOptions& common) -> RunFunction {
       auto opt = std::make_shared<NrrCliOptions>();
-      sub.add_option("MESH", opt->mesh, "input mesh .ply/.obj/.off")->required();
-      sub.add_option("--mode", opt->mode, "conventional | nrr-pixel | nrr-visibility | peel")->capture_default_str();
-      sub.add_option("--views", opt->views_file,
-                     "views JSON: a list of cameras, or {\"views\": [...], \"intermediate_views\": [...]}");
-      sub.add_option("--view-region", opt->region, "segment | triangle | rectangle (with --eyes, --target)");
-      sub.add_option("--eyes", opt->eyes, "corner eyes \"x,y,z;x,y,z[;...]\" (2, 3 or 4, rectangle in perimeter order)");
-      sub.add_option("--target", opt->target, "common look-at point x,y,z for --view-region");
-      sub.add_option("--up", opt->up, "common up vector for --view-region")->capture_default_str();
-      sub.add_option("--fov-y-deg", opt->fov_y_deg, "vertical field of view for --view-region, degrees")
-          ->capture_default_str();
-      sub.add_option("--resolution", opt->resolution, "image side in pixels for every view, 1..16384")
-          ->capture_default_str();
-      sub.add_option("--intermediate-views", opt->intermediate,
-                     "number of intermediate frames for metrics (3) and (4), spread over the eyes' region")
-          ->capture_default_str();
-      sub.add_option("--redundancy", opt->redundancy, "redundancy used by the metrics: pixel | visibility")
-          ->capture_default_str();
-      sub.add_option("--layers", opt->layers, "peel only: number of layers (0 = one per view)")->capture_default_str();
-      sub.add_flag("--no-metrics", opt->skip_metrics, "only render the images");
-      sub.add_option("-o,--out", opt->out_dir,
-                     "output folder: image_<i>.exr (+ .png preview) and image_<i>_samples.png (Fig. 6 colours)");
+      opt->lib.sampling.mode = nrr::SamplingMode::NrrPixel;
+      opt->lib.metrics.redundancy = nrr::Redundancy::Pixel;
+      add_options(sub, *opt);
       return [opt, &common] {
         const NrrCliOptions& o = *opt;
-        if (o.resolution < 1 || o.resolution > kMaxImageSide)
-          bad_flag("--resolution", "in 1.." + std::to_string(kMaxImageSide), std::to_string(o.resolution));
-        if (o.intermediate < 1) bad_flag("--intermediate-views", ">= 1", std::to_string(o.intermediate));
-        if (o.layers < 0) bad_flag("--layers", ">= 0", std::to_string(o.layers));
-        nrr::SamplingOptions sampling;
-        nrr::MetricsOptions metrics_options;
-        try {
-          sampling.mode = nrr::parse_sampling_mode(o.mode);
-        } catch (const InvalidInput&) {
-          bad_flag("--mode", "one of conventional, nrr-pixel, nrr-visibility, peel", "'" + o.mode + "'");
-        }
-        try {
-          metrics_options.redundancy = nrr::parse_redundancy(o.redundancy);
-        } catch (const InvalidInput&) {
-          bad_flag("--redundancy", "pixel or visibility", "'" + o.redundancy + "'");
-        }
         if (!o.out_dir.empty() && std::filesystem::exists(o.out_dir) && !std::filesystem::is_directory(o.out_dir))
           throw IoError(file_message(o.out_dir, "exists and is not a folder; -o takes an output folder"));
-        sampling.peel_layers = o.layers;
         const nrr::ViewSet views = views_from_options(o);
         if (!o.skip_metrics && views.views.size() > 4 && views.intermediate.empty())
           throw UsageError("metrics need 1-4 views (a point, segment, triangle or quadrilateral of eyes) or explicit "
                            "intermediate_views in the views file; got " + std::to_string(views.views.size()) +
                            " views; see --help (or pass --no-metrics)");
+        nrr::NrrPipelineOptions options = o.lib;
+        options.with_metrics = !o.skip_metrics;
 
         Timer load_timer;
         const TriMesh mesh = mesh::read_mesh(o.mesh);
         const nrr::SampledScene scene(mesh);
         const double load_ms = load_timer.elapsed_ms();
-
-        Timer render_timer;
-        const std::vector<nrr::DepthImage> images =
-            nrr::render_depth_images(scene, Span<const CameraSpec>(views.views), sampling);
-        const double render_ms = render_timer.elapsed_ms();
-        for (std::size_t i = 0; i < images.size(); ++i)
-          if (images[i].sample_count() == 0 && !common.quiet)
+        const nrr::NrrPipelineResult r = nrr::run_nrr_pipeline(scene, views, options);
+        for (std::size_t i = 0; i < r.images.size(); ++i)
+          if (r.images[i].sample_count() == 0 && !common.quiet)
             std::cerr << "raysift nrr: warning: image " << i << " holds no sample (does the view look away from "
                       << "the scene?)\n";
-
-        Json stats = {{"mesh", o.mesh},
-                      {"mode", o.mode},
-                      {"redundancy", o.redundancy},
-                      {"resolution", o.resolution},
-                      {"views", views.views.size()},
-                      {"triangles", scene.rays().triangle_count()},
-                      {"degenerate_triangles", scene.rays().degenerate_triangle_count()},
-                      {"triangle_pixel_ratio", triangle_pixel_ratio(scene, views.views[0])}};
-        nrr::SamplingMetrics m;
-        double metrics_ms = 0.0;
-        if (!o.skip_metrics) {
-          Timer metrics_timer;
-          std::vector<nrr::DepthImage> conventional;
-          if (sampling.mode != nrr::SamplingMode::Conventional) {
-            nrr::SamplingOptions conv = sampling;
-            conv.mode = nrr::SamplingMode::Conventional;
-            conventional = nrr::render_depth_images(scene, Span<const CameraSpec>(views.views), conv);
-          }
-          const std::vector<CameraSpec> intermediate =
-              views.intermediate.empty() ? nrr::intermediate_views(Span<const CameraSpec>(views.views), o.intermediate)
-                                         : views.intermediate;
-          m = nrr::compute_sampling_metrics(scene, sampling.mode, Span<const CameraSpec>(views.views),
-                                            Span<const nrr::DepthImage>(images),
-                                            Span<const nrr::DepthImage>(conventional.empty() ? images : conventional),
-                                            Span<const CameraSpec>(intermediate), metrics_options);
-          metrics_ms = metrics_timer.elapsed_ms();
-          stats["intermediate_views"] = intermediate.size();
-          stats["images"] = Json::array();
-          for (const nrr::ImageMetrics& im : m.images) stats["images"].push_back(image_json(im));
-          stats["view_dependent"] = {{"available_avg_pct", m.available_avg_pct},
-                                     {"available_min_pct", m.available_min_pct},
-                                     {"frames_with_samples", m.frames_with_samples}};
-        } else {
-          stats["images"] = Json::array();
-          for (const nrr::DepthImage& im : images) stats["images"].push_back({{"samples", im.sample_count()}});
-        }
-        stats["times_ms"] = {{"load", load_ms}, {"render", render_ms}, {"metrics", metrics_ms}};
-
-        if (!o.out_dir.empty()) {
-          const std::filesystem::path dir(o.out_dir);
-          std::filesystem::create_directories(dir);  // only now: a failed run leaves no folder behind
-          for (std::size_t i = 0; i < images.size(); ++i) {
-            const std::string stem = (dir / ("image_" + std::to_string(i))).string();
-            nrr::write_depth_image(images[i], stem + ".exr", stem + ".png");
-            if (!o.skip_metrics) write_image(stem + "_samples.png", nrr::sample_class_image(images[i], m.sample_classes[i]));
-          }
-        }
-        if (!common.quiet) {
-          std::printf("raysift nrr: %s, %zu images of %dx%d, render %.1f ms, metrics %.1f ms\n", o.mode.c_str(),
-                      images.size(), o.resolution, o.resolution, render_ms, metrics_ms);
-          for (std::size_t i = 0; i < images.size(); ++i) {
-            if (o.skip_metrics) {
-              std::printf("  image %zu: %zu samples\n", i, images[i].sample_count());
-              continue;
-            }
-            const nrr::ImageMetrics& im = m.images[i];
-            std::printf("  image %zu: %zu samples, %zu redundant, %zu disoccluded (%zu useful)\n", i, im.samples,
-                        im.redundant, im.disoccluded, im.useful);
-          }
-          if (!o.skip_metrics)
-            std::printf("  intermediate frames: available avg %.2f%%, min %.2f%% (%s redundancy)\n",
-                        m.available_avg_pct, m.available_min_pct, o.redundancy.c_str());
-        }
+        if (!o.out_dir.empty()) write_images(o.out_dir, r, options.with_metrics);
+        if (!common.quiet) print_summary(o, r);
         if (common.verbose)
-          std::printf("  times: load %.1f ms, render %.1f ms, metrics %.1f ms\n", load_ms, render_ms, metrics_ms);
-        write_stats_if_requested(common, stats);
+          std::printf("  times: load %.1f ms, render %.1f ms, metrics %.1f ms\n", load_ms, r.render_ms, r.metrics_ms);
+        write_stats_if_requested(common, stats_json(o, scene, views, r, load_ms));
       };
     },
     false);

@@ -4,6 +4,7 @@
 #include <memory>
 #include <sstream>
 
+#include "apps/raysift/cli_checks.h"
 #include "apps/raysift/command.h"
 #include "core/errors.h"
 #include "core/file_util.h"
@@ -27,23 +28,16 @@ RegisterCommand reg(
       auto opt = std::make_shared<SaliencyCliOptions>();
       sub.add_option("IMAGE", opt->image, "input image (PNG = sRGB, EXR = linear)")->required();
       sub.add_option("-o,--out", opt->out, "output map (.exr float, or .png grey); size = input size x scale")
-          ->required();
-      sub.add_option("--scale", opt->saliency.scale, "per-axis downscale before the analysis, in (0,1]")
-          ->capture_default_str();
+          ->required()->check(has_extension({".exr", ".png"}));
+      sub.add_option("--scale", opt->saliency.scale, "per-axis downscale before the analysis")
+          ->check(number_in(0, 1, End::Open))->capture_default_str();
       sub.add_flag("--no-orientation", opt->no_orientation,
                    "colour and intensity oppositions only (the RP paper's variant), no Gabor orientation");
       sub.footer(
           "Examples:\n"
           "  raysift saliency frame.png -o frame_saliency.exr\n"
-          "  raysift saliency frame.exr -o map.png --scale 0.5 --stats saliency.json");
+          "  raysift saliency frame.exr -o map.png --scale 0.5 --stats saliency.json\n");
       return [opt, &common] {
-        if (!(opt->saliency.scale > 0.0 && opt->saliency.scale <= 1.0)) {
-          std::ostringstream got;
-          got << opt->saliency.scale;
-          bad_flag("--scale", "in (0, 1]", got.str());
-        }
-        const std::string ext = file_extension(opt->out);
-        if (ext != ".exr" && ext != ".png") bad_flag("-o/--out", "a .exr or .png file", opt->out);
         opt->saliency.use_orientation = !opt->no_orientation;
 
         Timer timer;

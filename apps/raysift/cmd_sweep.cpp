@@ -8,9 +8,11 @@
 
 #include <cmath>
 
+#include "apps/raysift/cli_checks.h"
 #include "apps/raysift/command.h"
 #include "apps/raysift/sampling_flags.h"
 #include "apps/raysift/run_program.h"
+#include "apps/raysift/volume_input.h"
 #include "core/file_util.h"
 #include "core/scene.h"
 #include "isosurface/feature_geometry.h"
@@ -22,40 +24,23 @@ namespace {
 
 struct SweepOptions {
   std::string scene, out, plot;
-  std::string fractions = "0.1,0.2,0.4,0.7";
-  std::string budgets_ms, time_fractions, steps, early_terminations;
+  std::string grid, tf;
+  bool tf_normalized = false;
+  std::vector<double> fractions = sampling::TradeOptions{}.ray_fractions;
+  std::vector<double> budgets_ms, time_fractions, steps, early_terminations;
   std::string features = "contours,silhouettes";
-  std::string alpha;
+  std::vector<float> alpha;
   std::string feature_mesh;
   std::string shading = "phong";
   int width = -1, height = -1;
   int repeats = 1;
 };
 
-/// A comma-separated list of numbers each satisfying `ok`; exit 2 naming the first bad entry.
-template <typename Ok>
-std::vector<double> parse_list(const std::string& flag, const std::string& text, const std::string& expected, Ok ok) {
-  std::vector<double> out;
-  std::stringstream s(text);
-  std::string item;
-  while (std::getline(s, item, ',')) {
-    char* end = nullptr;
-    const double v = std::strtod(item.c_str(), &end);
-    if (item.empty() || *end != '\0' || !ok(v)) bad_flag(flag, expected + " (bad entry '" + item + "')", text);
-    out.push_back(v);
-  }
-  if (out.empty()) bad_flag(flag, expected, text);
-  return out;
+/// A comma-separated list option whose every entry passes `check`.
+CLI::Option* add_list(CLI::App& sub, const std::string& flag, std::vector<double>& values, const std::string& help,
+                      const CLI::Validator& check) {
+  return sub.add_option(flag, values, help)->delimiter(',')->check(check);
 }
-
-std::vector<double> optional_list(const std::string& flag, const std::string& text, const std::string& expected,
-                                  bool (*ok)(double)) {
-  return text.empty() ? std::vector<double>{} : parse_list(flag, text, expected, ok);
-}
-
-bool is_fraction(double v) { return v > 0 && v <= 1; }
-bool is_positive(double v) { return v > 0 && std::isfinite(v); }
-bool is_step(double v) { return v > 0 && v <= 64; }
 
 void write_text(const std::string& path, const std::string& text) {
   write_atomically(path, [&](const std::string& tmp) {
@@ -86,72 +71,70 @@ RegisterCommand reg(
     [](CLI::App& sub, CommonOptions& common) -> RunFunction {
       auto opt = std::make_shared<SweepOptions>();
       sub.add_option("SCENE", opt->scene, "scene JSON (volume, transfer_function, camera)")->required();
-      sub.add_option("-o,--out", opt->out, "CSV output, one row per (mode, fraction)")->required();
-      sub.add_option("--ray-fractions", opt->fractions, "comma-separated fractions in (0, 1]")->capture_default_str();
-      sub.add_option("--budgets-ms", opt->budgets_ms, "also prioritized and control rows at these frame budgets (ms)");
-      sub.add_option("--time-fractions", opt->time_fractions,
-                     "also prioritized and control rows at these fractions of the full frame time, (0, 1]");
-      sub.add_option("--steps", opt->steps, "also full renders at these sampling steps (voxels, (0, 64])");
-      sub.add_option("--early-termination", opt->early_terminations,
-                     "also full renders at these early-termination opacities, (0, 1]");
-      sub.add_option("--plot", opt->plot, "also draw error vs frame time for every mode and knob (PNG)");
-      sub.add_option("--features", opt->features, "line classes of the prioritized rows")->capture_default_str();
-      sub.add_option("--alpha", opt->alpha, alpha_flag_help());
-      sub.add_option("--feature-mesh", opt->feature_mesh, "prepared feature mesh instead of the iso-surfaces");
-      sub.add_option("--shading", opt->shading, "none|phong")->capture_default_str();
-      sub.add_option("--width", opt->width, "image width (default: the scene camera's)");
-      sub.add_option("--height", opt->height, "image height (default: the scene camera's)");
-      sub.add_option("--repeats", opt->repeats, "frames per row; times are the minimum")->capture_default_str();
+      sub.add_option("-o,--out", opt->out, "CSV output, one row per (mode, fraction)")->required()
+          ->check(has_extension({".csv"}));
+      sub.add_option("--grid", opt->grid, "grid name (default: the scene's, else the first non-empty float grid)");
+      sub.add_option("--tf", opt->tf, "transfer function JSON (default: the scene's)");
+      sub.add_flag("--tf-normalized", opt->tf_normalized, "TF x values are 0..1 over the data range");
+      auto* rows = sub.add_option_group("Rows");
+      add_list(*rows, "--ray-fractions", opt->fractions, "ray fractions", number_in(0, 1, End::Open))
+          ->capture_default_str();
+      add_list(*rows, "--budgets-ms", opt->budgets_ms, "also prioritized and control rows at these frame budgets (ms)",
+               number_in(0, INFINITY, End::Open));
+      add_list(*rows, "--time-fractions", opt->time_fractions,
+               "also prioritized and control rows at these fractions of the full frame time",
+               number_in(0, 1, End::Open));
+      add_list(*rows, "--steps", opt->steps, "also full renders at these sampling steps (voxels)",
+               number_in(0, 64, End::Open));
+      add_list(*rows, "--early-termination", opt->early_terminations,
+               "also full renders at these early-termination opacities", number_in(0, 1, End::Open));
+      rows->add_option("--repeats", opt->repeats, "frames per row; times are the minimum")
+          ->check(CLI::PositiveNumber)->capture_default_str();
+      auto* render = sub.add_option_group("Rendering");
+      render->add_option("--features", opt->features, "line classes of the prioritized rows")->capture_default_str();
+      add_alpha_option(*render, opt->alpha);
+      render->add_option("--feature-mesh", opt->feature_mesh, "prepared feature mesh instead of the iso-surfaces");
+      render->add_option("--shading", opt->shading, "none|phong")->check(CLI::IsMember({"none", "phong"}))
+          ->capture_default_str();
+      render->add_option("--width", opt->width, "image width (default: the scene camera's)")->check(image_side());
+      render->add_option("--height", opt->height, "image height (default: the scene camera's)")->check(image_side());
+      sub.add_option("--plot", opt->plot, "also draw error vs frame time for every mode and knob (PNG)")
+          ->check(has_extension({".png"}));
       sub.footer(
           "Example:\n  raysift sweep datasets/engine_ct_scene.json --ray-fractions 0.1,0.2,0.4,0.7 -o trade.csv "
-          "--plot trade.png");
+          "--plot trade.png\n");
       return [opt, &common] {
-        const std::vector<double> fractions =
-            parse_list("--ray-fractions", opt->fractions, "comma-separated fractions in (0, 1]", is_fraction);
-        const std::vector<double> steps =
-            optional_list("--steps", opt->steps, "comma-separated steps in (0, 64] voxels", is_step);
-        const std::vector<double> early_terminations = optional_list(
-            "--early-termination", opt->early_terminations, "comma-separated opacities in (0, 1]", is_fraction);
-        if (opt->repeats < 1) bad_flag("--repeats", ">= 1", std::to_string(opt->repeats));
-        if (opt->shading != "none" && opt->shading != "phong") bad_flag("--shading", "none|phong", opt->shading);
-        if (file_extension(opt->out) != ".csv") bad_flag("-o/--out", "a .csv path", opt->out);
-        if (!opt->plot.empty() && file_extension(opt->plot) != ".png") bad_flag("--plot", "a .png path", opt->plot);
         sampling::TradeOptions trade;
-        trade.ray_fractions = fractions;
-        trade.budgets_ms = optional_list("--budgets-ms", opt->budgets_ms, "comma-separated budgets > 0 ms", is_positive);
-        trade.time_fractions =
-            optional_list("--time-fractions", opt->time_fractions, "comma-separated fractions in (0, 1]", is_fraction);
+        trade.ray_fractions = opt->fractions;
+        trade.budgets_ms = opt->budgets_ms;
+        trade.time_fractions = opt->time_fractions;
         trade.repeats = opt->repeats;
         trade.sampling.seed = common.seed;
+        if (!opt->alpha.empty()) std::copy(opt->alpha.begin(), opt->alpha.end(), trade.sampling.mapping.alpha.begin());
         try {
-          if (!opt->alpha.empty()) trade.sampling.mapping = sampling::parse_priority_mapping(opt->alpha);
           trade.features.classes = sampling::parse_feature_list(opt->features);
         } catch (const InvalidInput& e) {
-          throw UsageError(std::string(e.what()) + "; see --help");
+          throw UsageError(std::string("--features: ") + e.what() + "; see --help");
         }
 
-        const Scene scene = load_scene(opt->scene);
-        if (scene.volume.empty()) throw InvalidInput(file_message(opt->scene, "the scene has no 'volume'"));
-        if (scene.transfer_function.is_null())
-          throw InvalidInput(file_message(opt->scene, "the scene has no 'transfer_function'"));
-        const volume::Volume vol = volume::load_vdb(scene.volume, scene.grid);
-        const volume::TransferFunction tf =
-            volume::transfer_function_from_json(scene.transfer_function, scene.transfer_function_source);
-        CameraSpec camera = scene.camera ? *scene.camera : volume::fit_camera(vol, 1440, 900);
+        const VolumeInput in = load_volume_input("", opt->grid, opt->tf, opt->tf_normalized, opt->scene, "sweep");
+        if (!in.tf) throw InvalidInput(file_message(opt->scene, "the scene has no 'transfer_function'"));
+        CameraSpec camera = in.scene.camera ? *in.scene.camera : volume::fit_camera(in.volume, CameraSpec{}.width, CameraSpec{}.height);
         if (opt->width != -1) camera.width = opt->width;
         if (opt->height != -1) camera.height = opt->height;
         volume::RenderOptions render;
         render.shading = opt->shading == "phong" ? volume::Shading::Phong : volume::Shading::None;
-        const volume::RayCaster caster(vol, tf, camera, render);
+        const volume::RayCaster caster(in.volume, *in.tf, camera, render);
 
         sampling::FeatureGeometry geometry;
         if (!trade.features.classes.is_empty())
-          geometry = opt->feature_mesh.empty() ? isosurface::build_feature_geometry(vol, tf, feature_options(camera, trade))
-                                               : isosurface::load_feature_geometry(opt->feature_mesh, &vol);
+          geometry = opt->feature_mesh.empty()
+                         ? isosurface::build_feature_geometry(in.volume, *in.tf, feature_options(camera, trade))
+                         : isosurface::load_feature_geometry(opt->feature_mesh, &in.volume);
         sampling::TradeResult result =
             sampling::run_trade(caster, trade.features.classes.is_empty() ? nullptr : &geometry, trade);
-        const std::vector<sampling::TradeRow> knobs =
-            sampling::run_render_knobs(vol, tf, camera, render, steps, early_terminations, result, trade);
+        const std::vector<sampling::TradeRow> knobs = sampling::run_render_knobs(
+            in.volume, *in.tf, camera, render, opt->steps, opt->early_terminations, result, trade);
         result.rows.insert(result.rows.end(), knobs.begin(), knobs.end());
         const std::string csv = sampling::trade_csv(result.rows);
         write_text(opt->out, csv);

@@ -3,7 +3,9 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <iomanip>
 #include <iostream>
+#include <sstream>
 #include <utility>
 
 #include "apps/raysift/command.h"
@@ -24,12 +26,52 @@ void bad_flag(const std::string& flag, const std::string& range, const std::stri
   throw UsageError(flag + " must be " + range + ", got " + got + "; see --help");
 }
 
+namespace {
+
+/// Levenshtein distance: the number of single-character edits from a to b.
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t substitute = diagonal + (a[i - 1] == b[j - 1] ? 0 : 1);
+      diagonal = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, substitute});
+    }
+  }
+  return row[b.size()];
+}
+
+/// "unknown command 'rendr'; did you mean 'render'?" when `word` names no command (CLI11 alone would list
+/// the unexpected arguments instead); "" when it is one.
+std::string unknown_command_message(const std::string& word, const std::vector<std::string>& names) {
+  if (std::find(names.begin(), names.end(), word) != names.end()) return "";
+  std::string nearest = names.front();
+  for (const std::string& n : names)
+    if (edit_distance(word, n) < edit_distance(word, nearest)) nearest = n;
+  return "unknown command '" + word + "'; did you mean '" + nearest + "'? ('raysift help' lists the commands)";
+}
+
+/// One line per command: its name and the first line of its description.
+std::string command_list(const CLI::App& cli) {
+  std::ostringstream s;
+  s << cli.get_description() << "\n\nUsage: raysift COMMAND [OPTIONS] [ARGS]\n\nCommands:\n";
+  for (const CLI::App* sub : cli.get_subcommands({}))
+    s << "  " << std::left << std::setw(12) << sub->get_name() << " " << sub->get_description() << "\n";
+  s << "\n'raysift COMMAND --help' prints a command's options with their defaults, and examples.\n";
+  return s.str();
+}
+
+}  // namespace
+
 }  // namespace raysift::app
 
 int main(int argc, char** argv) {
   using namespace raysift;
   using namespace raysift::app;
-  CLI::App cli{"raysift: prioritized volume ray casting and non-redundant scene discretization"};
+  CLI::App cli{"raysift: prioritized volume ray casting and non-redundant scene discretization", "raysift"};
   cli.set_version_flag("--version", std::string("raysift ") + RAYSIFT_VERSION);
   cli.require_subcommand(0, 1);
   CommonOptions common;
@@ -48,8 +90,18 @@ int main(int argc, char** argv) {
     if (entry.takes_scene) sub->add_option("--scene", common.scene_path, "scene JSON (flags override its fields)");
     runners.emplace_back(sub, entry.setup(*sub, common));
   }
-  CLI::App* help = cli.add_subcommand("help", "list the subcommands");
+  CLI::App* help = cli.add_subcommand("help", "list the commands, or print one command's help");
+  std::string help_topic;
+  help->add_option("COMMAND", help_topic, "the command whose --help to print");
 
+  std::vector<std::string> names;
+  for (const CLI::App* sub : cli.get_subcommands({})) names.push_back(sub->get_name());
+  if (argc >= 2 && argv[1][0] != '-') {
+    if (const std::string unknown = unknown_command_message(argv[1], names); !unknown.empty()) {
+      std::cerr << "raysift: error: " << unknown << "\n";
+      return 2;
+    }
+  }
   try {
     cli.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -65,8 +117,16 @@ int main(int argc, char** argv) {
   RunFunction run;
   for (auto& [sub, runner] : runners)
     if (sub->parsed()) run = runner;
+  if (help->parsed() && !help_topic.empty()) {
+    if (const std::string unknown = unknown_command_message(help_topic, names); !unknown.empty()) {
+      std::cerr << "raysift: error: " << unknown << "\n";
+      return 2;
+    }
+    std::cout << cli.get_subcommand(help_topic)->help();
+    return 0;
+  }
   if (help->parsed() || !run) {
-    std::cout << cli.help();
+    (help->parsed() ? std::cout : std::cerr) << command_list(cli);
     return help->parsed() ? 0 : 2;
   }
   try {

@@ -1,10 +1,14 @@
 #include "apps/raysift/sampling_flags.h"
 
+#include <cmath>
 #include <sstream>
 
+#include "apps/raysift/cli_checks.h"
 #include "sampling/ray_order.h"
 
 namespace raysift::app {
+
+namespace {
 
 std::string alpha_flag_help() {
   std::ostringstream s;
@@ -14,6 +18,30 @@ std::string alpha_flag_help() {
   for (std::size_t i = 0; i < a.size(); ++i) s << (i ? "," : "") << a[i];
   s << ")";
   return s.str();
+}
+
+}  // namespace
+
+void add_alpha_option(CLI::App& app, std::vector<float>& alpha, const std::string& help_prefix) {
+  app.add_option("--alpha", alpha, help_prefix + alpha_flag_help())
+      ->delimiter(',')
+      ->expected(6)
+      ->check(number_in(-INFINITY, INFINITY));
+}
+
+std::string split_saliency_feature(const std::string& list, bool& has_saliency) {
+  has_saliency = false;
+  std::string rest;
+  std::stringstream items(list);
+  std::string item;
+  while (std::getline(items, item, ',')) {
+    if (item == "saliency") {
+      has_saliency = true;
+    } else if (!item.empty() && item != "none") {
+      rest += (rest.empty() ? "" : ",") + item;
+    }
+  }
+  return rest.empty() ? "none" : rest;
 }
 
 }  // namespace raysift::app

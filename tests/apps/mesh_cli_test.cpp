@@ -84,7 +84,7 @@ TEST_F(MeshCli, BadInputFailsWithoutOutput) {
       {"mesh ../empty.vdb --iso 0.5 -o c.ply", 1, "no active voxels"},
       {"mesh ../ball.vdb --iso 0.5 --decimate 0 -o d.ply", 2, "--decimate"},
       {"mesh ../ball.vdb --iso 0.5 --smooth -1 -o e.ply", 2, "--smooth"},
-      {"mesh ../ball.vdb --iso 0.5 --decimate 0.5 --faces 100 -o f.ply", 2, "exclusive"},
+      {"mesh ../ball.vdb --iso 0.5 --decimate 0.5 --faces 100 -o f.ply", 2, "excludes"},
   };
   // Independent runs in parallel (process start-up dominates), each in its own folder for its captured output.
   std::vector<std::future<CliRun>> runs;

@@ -198,12 +198,12 @@ TEST(RenderCameraPath, FullModeOnAnOrbitMatchesSingleRenders) {
     EXPECT_EQ(frames[i].ssim_vs_full, 1.0);
     EXPECT_EQ(frames[i].rays_traced, 48u * 48u);
   }
-  const Json stats = path_stats_json(frames, 0);
-  EXPECT_EQ(stats.at("frames").size(), 3u);
-  EXPECT_EQ(stats.at("mean_ssim_vs_full"), 1.0);
+  const PathSummary summary = summarize_path(frames, 0);
+  EXPECT_EQ(summary.mean_ssim_vs_full, 1.0);
+  EXPECT_EQ(summary.target_ms, 0.0);
 }
 
-TEST(RenderCameraPath, RequestWritesEveryFrameAndItsStats) {
+TEST(RenderCameraPath, RequestHandsEveryFrameToTheSink) {
   const PathScene scene;
   const std::string dir = test::make_temp_dir("camera_path_request");
   write_json_file(dir + "/orbit.json",
@@ -211,32 +211,24 @@ TEST(RenderCameraPath, RequestWritesEveryFrameAndItsStats) {
                                             "frames": 3, "width": 40, "height": 32}})"));
   PathRenderRequest req;
   req.camera_path = dir + "/orbit.json";
-  req.out_pattern = dir + "/f_%02d.exr";
   req.options.sampling.mode = SamplingMode::Prioritized;
   req.options.sampling.ray_fraction = 0.3;
-  const Json stats = run_path_request(scene.vol, scene.tf, {}, scene.camera(0), req);
-  for (int i = 0; i < 3; ++i) {
-    const ImageRGBA img = read_image_rgba(frame_file_name(req.out_pattern, i));
-    EXPECT_EQ(img.width, 40);
-    EXPECT_EQ(img.height, 32);
-  }
-  ASSERT_EQ(stats.at("frames").size(), 3u);
-  EXPECT_EQ(stats.at("frame_files").at(1), dir + "/f_02.exr");
-  EXPECT_TRUE(stats.at("frames").at(2).at("ssim_vs_full").is_null());
-  EXPECT_GT(stats.at("frames").at(2).at("rays_traced").get<std::size_t>(), 0u);
-  req.out_pattern = dir + "/single.exr";
-  EXPECT_THROW(run_path_request(scene.vol, scene.tf, {}, scene.camera(0), req), InvalidInput);
+  std::vector<int> indices;
+  const PathRenderResult r = run_path_request(scene.vol, scene.tf, {}, scene.camera(0), req,
+                                              [&](const PathFrame& f, const ImageRGBA& img) {
+                                                indices.push_back(f.index);
+                                                EXPECT_EQ(img.width, 40);
+                                                EXPECT_EQ(img.height, 32);
+                                              });
+  EXPECT_EQ(indices, (std::vector<int>{0, 1, 2}));
+  ASSERT_EQ(r.frames.size(), 3u);
+  EXPECT_FALSE(std::isfinite(r.frames[2].ssim_vs_full));  // not compared
+  EXPECT_GT(r.frames[2].rays_traced, 0u);
+  EXPECT_FALSE(summarize_path(r.frames, 0).mean_ssim_vs_full);
+  req.camera_path = dir + "/missing.json";
+  EXPECT_THROW(run_path_request(scene.vol, scene.tf, {}, scene.camera(0), req, {}), IoError);
 }
 
-TEST(RenderCameraPath, SplitsSaliencyFromTheFeatureList) {
-  bool has = false;
-  EXPECT_EQ(split_saliency_feature("contours,saliency,ridges", has), "contours,ridges");
-  EXPECT_TRUE(has);
-  EXPECT_EQ(split_saliency_feature("saliency", has), "none");
-  EXPECT_TRUE(has);
-  EXPECT_EQ(split_saliency_feature("contours,silhouettes", has), "contours,silhouettes");
-  EXPECT_FALSE(has);
-}
 
 TEST(RenderCameraPath, RejectsBadRequests) {
   const PathScene scene;

@@ -97,16 +97,34 @@ TEST(VdbIo, UnknownGridListsAvailableGrids) {
   EXPECT_NE(msg.find("'velocity' (vec3s)"), std::string::npos) << msg;
 }
 
+TEST(VdbIo, DefaultGridIsTheFirstNonEmptyFloatGrid) {
+  // The fixture holds an empty float grid before 'density' (the one default-grid rule of every command).
+  EXPECT_EQ(load_vdb(kMixed).name(), "density");
+  EXPECT_EQ(default_grid_name(inspect_vdb(kMixed)), "density");
+  GridInfo empty_float, labels;
+  empty_float.name = "e";
+  empty_float.type = "float";
+  labels.name = "l";
+  labels.type = "int32";
+  labels.active_voxels = 9;
+  EXPECT_EQ(default_grid_name({labels, empty_float}), "e");  // no non-empty float grid: the first float grid
+  EXPECT_EQ(default_grid_name({labels}), "");
+}
+
 TEST(VdbIo, NonFloatGridNamesItsType) {
   const std::string msg = message_of<InvalidInput>([&] { load_vdb(kMixed, "labels"); });
   EXPECT_NE(msg.find("int32"), std::string::npos) << msg;
 }
 
 TEST(VdbIo, EmptyGridRejectedUnlessAllowed) {
-  // The first float grid in the fixture is 'empty'.
-  const std::string msg = message_of<InvalidInput>([&] { load_vdb(kMixed); });
+  // The first float grid in the fixture is 'empty'; named, it is rejected.
+  const std::string msg = message_of<InvalidInput>([&] { load_vdb(kMixed, "empty"); });
   EXPECT_NE(msg.find("'empty'"), std::string::npos) << msg;
   EXPECT_TRUE(load_vdb(kMixed, "empty", EmptyGrid::Allow).is_empty());
+  // A file whose only float grid is empty is rejected by default too.
+  const std::string only_empty = test::make_temp_dir("vdb_empty") + "/empty.vdb";
+  save_vdb(only_empty, make_empty());
+  EXPECT_NE(message_of<InvalidInput>([&] { load_vdb(only_empty); }).find("no active voxels"), std::string::npos);
   const Volume density = load_vdb(kMixed, "density");
   EXPECT_EQ(density.active_voxel_count(), 2u);
   EXPECT_FLOAT_EQ(density.value_at({5, 6, 7}), 0.75f);

@@ -1,0 +1,41 @@
+#include "apps/raysift/cli_checks.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "core/file_util.h"
+
+namespace raysift::app {
+
+CLI::Validator number_in(double lo, double hi, End lo_end, End hi_end) {
+  std::ostringstream range;
+  if (std::isinf(lo) && std::isinf(hi)) {
+    range << "(-inf, inf)";  // any finite number
+  } else {
+    range << (lo_end == End::Open ? "(" : "[") << lo << ", " << hi << (hi_end == End::Open || std::isinf(hi) ? ")" : "]");
+  }
+  return CLI::Validator(
+      [lo, hi, lo_end, hi_end, text = range.str()](std::string& value) -> std::string {
+        double v = 0;
+        const bool parsed = CLI::detail::lexical_cast(value, v);
+        const bool above = lo_end == End::Open ? v > lo : v >= lo;
+        const bool below = hi_end == End::Open ? v < hi : v <= hi;
+        if (parsed && std::isfinite(v) && above && below) return "";
+        return "must be a number in " + text + ", got '" + value + "'";
+      },
+      "in " + range.str(), "number_in");
+}
+
+CLI::Validator has_extension(const std::vector<std::string>& extensions) {
+  std::string names;
+  for (const std::string& e : extensions) names += (names.empty() ? "" : "|") + e;
+  return CLI::Validator(
+      [extensions, names](std::string& path) -> std::string {
+        for (const std::string& e : extensions)
+          if (file_extension(path) == e) return "";
+        return "must be a " + names + " path, got " + path;
+      },
+      "PATH(" + names + ")", "extension");
+}
+
+}  // namespace raysift::app
