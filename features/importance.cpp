@@ -1,9 +1,5 @@
 #include "features/importance.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/blocked_range2d.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -36,19 +32,6 @@ void validate(const ImportanceOptions& o, const BackgroundGeometry& bg) {
                          " must be in [0, 1], got " + std::to_string(o.priority[std::size_t(c)]));
   if (bg.bbox_ws && (bg.bbox_ws->is_empty() || !is_finite(bg.bbox_ws->min) || !is_finite(bg.bbox_ws->max)))
     throw InvalidInput("importance: the background bounding box is empty or not finite");
-}
-
-template <typename F>
-void for_pixels(int width, int height, bool threaded, const F& f) {
-  if (threaded) {
-    tbb::parallel_for(tbb::blocked_range2d<int>(0, height, 16, 0, width, 64), [&](const tbb::blocked_range2d<int>& r) {
-      for (int y = r.rows().begin(); y != r.rows().end(); ++y)
-        for (int x = r.cols().begin(); x != r.cols().end(); ++x) f(x, y);
-    });
-  } else {
-    for (int y = 0; y < height; ++y)
-      for (int x = 0; x < width; ++x) f(x, y);
-  }
 }
 
 /// Slab test: does the ray hit the box at some t >= 0 (a camera inside the box always hits)? The direction
@@ -94,18 +77,18 @@ Image<std::uint8_t> coverage(const Camera& camera, const BackgroundGeometry& bg,
   }
   if (mesh_frame_depth) {
     const ImageF& d = mesh_frame_depth->depth;
-    for_pixels(w, h, threaded, [&](int x, int y) {
+    parallel_pixels(w, h, [&](int x, int y) {
       const int fx0 = x * d.width / w, fx1 = std::max(fx0 + 1, (x + 1) * d.width / w);
       const int fy0 = y * d.height / h, fy1 = std::max(fy0 + 1, (y + 1) * d.height / h);
       for (int fy = fy0; fy < std::min(fy1, d.height); ++fy)
         for (int fx = fx0; fx < std::min(fx1, d.width); ++fx)
           if (d(fx, fy) != std::numeric_limits<float>::infinity()) hit(x, y) = 1;
-    });
+    }, threaded);
   } else if (bg.mesh) {
     const DepthBuffer db = rasterize_depth(*bg.mesh, camera, {threaded});
-    for_pixels(w, h, threaded, [&](int x, int y) {
+    parallel_pixels(w, h, [&](int x, int y) {
       if (db.face(x, y) != kNoFace) hit(x, y) = 1;
-    });
+    }, threaded);
   }
   return hit;
 }
@@ -145,12 +128,12 @@ ImportanceBuffer rasterize(const FeatureLines& visible, const Camera& frame, con
                                          [&](int x, int y, double, const detail::Segment2&) { seeds(x, y) = 1; });
     const ImageF d2 = detail::squared_distance_transform(seeds, 0.5 + falloff, o.threaded);
     const float reach2 = float((0.5 + falloff) * (0.5 + falloff));
-    for_pixels(w, h, o.threaded, [&](int x, int y) {
+    parallel_pixels(w, h, [&](int x, int y) {
       if (d2(x, y) >= reach2) return;  // beyond the fall-off: contributes 0
       const double u = std::clamp((std::sqrt(double(d2(x, y))) - 0.5) / falloff, 0.0, 1.0);
       float& cur = out.values(x, y);
       cur = std::max(cur, float(level * (1.0 - u * u * (3.0 - 2.0 * u))));
-    });
+    }, o.threaded);
   }
 
   if (bg.bbox_ws || bg.mesh) {
@@ -158,13 +141,13 @@ ImportanceBuffer rasterize(const FeatureLines& visible, const Camera& frame, con
     // Conservative: background only if no neighbouring buffer pixel sees the geometry, so that upsampling
     // to the frame never skips a frame pixel whose ray hits it.
     Image<std::uint8_t> row_hit(w, h, 0);  // separable 3x3 dilation: rows, then columns
-    for_pixels(w, h, o.threaded, [&](int x, int y) {
+    parallel_pixels(w, h, [&](int x, int y) {
       row_hit(x, y) = hit(x, y) | (x > 0 ? hit(x - 1, y) : 0) | (x + 1 < w ? hit(x + 1, y) : 0);
-    });
-    for_pixels(w, h, o.threaded, [&](int x, int y) {
+    }, o.threaded);
+    parallel_pixels(w, h, [&](int x, int y) {
       if (!(row_hit(x, y) | (y > 0 ? row_hit(x, y - 1) : 0) | (y + 1 < h ? row_hit(x, y + 1) : 0)))
         out.values(x, y) = o.background_value;
-    });
+    }, o.threaded);
   }
   return out;
 }

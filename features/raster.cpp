@@ -1,14 +1,12 @@
 #include "features/raster.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
 
 #include "core/errors.h"
+#include "core/parallel.h"
 
 namespace raysift::features {
 namespace {
@@ -138,19 +136,6 @@ struct ViewPoint {
   double x, y, z;  // along right, image up, forward (z = view depth)
 };
 
-template <typename F>
-void for_chunks(std::size_t n, std::size_t chunk, bool threaded, const F& body) {
-  const std::size_t chunks = (n + chunk - 1) / chunk;
-  auto run = [&](std::size_t c) { body(c, c * chunk, std::min(n, (c + 1) * chunk)); };
-  if (threaded) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t c = r.begin(); c != r.end(); ++c) run(c);
-    });
-  } else {
-    for (std::size_t c = 0; c < chunks; ++c) run(c);
-  }
-}
-
 
 }  // namespace
 
@@ -190,13 +175,13 @@ DepthBuffer rasterize_depth(const TriMesh& mesh, const Camera& camera, const Ras
     return ScreenPoint{float((p.x / p.z / tan_x + 1.0) * 0.5 * width), float((1.0 - p.y / p.z / tan_y) * 0.5 * height),
                        float(1.0 / p.z)};
   };
-  for_chunks(view.size(), 8192, options.threaded, [&](std::size_t, std::size_t b, std::size_t e) {
+  parallel_chunks(view.size(), 8192, [&](std::size_t, std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       const Vec3d d = Vec3d(mesh.positions[i]) - camera.eye();
       view[i] = {dot(d, camera.right()), dot(d, camera.image_up()), dot(d, camera.forward())};
       screen[i] = view[i].z >= near ? to_screen(view[i]) : ScreenPoint{0, 0, -1};
     }
-  });
+  }, options.threaded);
 
   // Per chunk of faces (in parallel): clip at the near plane, set up the edge and depth planes once, and
   // bin the triangles into bands of rows. The depth test breaks ties by face index, so the order in
@@ -204,7 +189,7 @@ DepthBuffer rasterize_depth(const TriMesh& mesh, const Camera& camera, const Ras
   constexpr std::size_t kChunk = 8192;
   const int bands = (height + kBandRows - 1) / kBandRows;
   std::vector<Chunk> chunks((mesh.triangle_count() + kChunk - 1) / kChunk);
-  for_chunks(mesh.triangle_count(), kChunk, options.threaded, [&](std::size_t c, std::size_t b, std::size_t e) {
+  parallel_chunks(mesh.triangle_count(), kChunk, [&](std::size_t c, std::size_t b, std::size_t e) {
     std::vector<std::vector<ScreenTri>>& by_band = chunks[c].bands;
     by_band.resize(std::size_t(bands));
     auto add = [&](const ScreenPoint* p0, const ScreenPoint* p1, const ScreenPoint* p2, std::uint32_t face) {
@@ -234,9 +219,9 @@ DepthBuffer rasterize_depth(const TriMesh& mesh, const Camera& camera, const Ras
       for (int k = 0; k < n; ++k) sp[k] = to_screen(poly[k]);
       for (int k = 1; k + 1 < n; ++k) add(&sp[0], &sp[k], &sp[k + 1], std::uint32_t(f));
     }
-  });
+  }, options.threaded);
 
-  for_chunks(std::size_t(bands), 1, options.threaded, [&](std::size_t b, std::size_t, std::size_t) {
+  parallel_chunks(std::size_t(bands), 1, [&](std::size_t b, std::size_t, std::size_t) {
     const int band_r0 = int(b) * kBandRows, band_r1 = std::min(height - 1, band_r0 + kBandRows - 1);
     const std::size_t n = std::size_t(band_r1 - band_r0 + 1) * std::size_t(width);
     Band band{band_r0, width, std::vector<double>(n, 0.0), std::vector<std::uint32_t>(n, kNoFace)};
@@ -248,7 +233,7 @@ DepthBuffer rasterize_depth(const TriMesh& mesh, const Camera& camera, const Ras
       out.depth.pixels[std::size_t(band_r0) * std::size_t(width) + i] = float(1.0 / band.inv_z[i]);
       out.face.pixels[std::size_t(band_r0) * std::size_t(width) + i] = band.face[i];
     }
-  });
+  }, options.threaded);
   return out;
 }
 

@@ -1,8 +1,5 @@
 #include "features/saliency.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -36,17 +33,6 @@ constexpr int kGaborRadius = 4;           // 9x9 kernel [choice]
 constexpr double kGaborWavelengthPx = 4;  // [choice]
 constexpr double kGaborSigmaPx = 2;       // [choice]
 constexpr int kOrientations = 4;          // 0, 45, 90, 135 degrees
-
-template <typename F>
-void for_items(int count, bool threaded, const F& item) {
-  if (!threaded) {
-    for (int i = 0; i < count; ++i) item(i);
-    return;
-  }
-  tbb::parallel_for(tbb::blocked_range<int>(0, count, 1), [&](const tbb::blocked_range<int>& r) {
-    for (int i = r.begin(); i < r.end(); ++i) item(i);
-  });
-}
 
 void validate(const ImageRGBA& image, const SaliencyOptions& options) {
   std::ostringstream why;
@@ -410,7 +396,7 @@ ImageF compute_saliency(const ImageRGBA& image, const SaliencyOptions& options) 
   // fixed order, so the result does not depend on scheduling.
   const Plane& base = pyramids[0][kConspicuityLevel];
   std::vector<Plane> features(specs.size());
-  for_items(int(specs.size()), threaded, [&](int i) {
+  parallel_for_each(int(specs.size()), [&](int i) {
     const FeatureSpec& f = specs[std::size_t(i)];
     const Plane& centre = pyramids[std::size_t(f.channel)][std::size_t(f.centre)];
     const Plane& surround = pyramids[std::size_t(f.channel)][std::size_t(f.surround)];
@@ -419,7 +405,7 @@ ImageF compute_saliency(const ImageRGBA& image, const SaliencyOptions& options) 
     normalize_map(diff, kContrastFloorLab);
     const int up = 1 << (f.centre - kConspicuityLevel);
     features[std::size_t(i)] = up == 1 ? std::move(diff) : expand_to(diff, base.width, base.height, up);
-  });
+  }, threaded);
 
   const auto sum_of = [&](int first_channel, int last_channel) {
     Plane acc(base.width, base.height, 0.f);

@@ -1,13 +1,11 @@
 #include "mesh/curvature.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <string>
 
 #include "core/errors.h"
+#include "core/parallel.h"
 #include "core/span.h"
 
 namespace raysift::mesh {
@@ -15,17 +13,6 @@ namespace {
 
 using Tensor = std::array<double, 3>;   // (e, f, g): second fundamental form in some (u, v) frame
 using DTensor = std::array<double, 4>;  // (C111, C112, C122, C222)
-
-template <typename F>
-void for_range(std::size_t n, bool threaded, const F& body) {
-  if (threaded) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
-    });
-  } else {
-    for (std::size_t i = 0; i < n; ++i) body(i);
-  }
-}
 
 /// Solves the symmetric system A x = b by LDLᵀ (A is a least-squares normal matrix). Returns false when a
 /// pivot is not clearly positive (relative to the largest diagonal entry): the face is then skipped, as
@@ -252,7 +239,7 @@ MeshCurvature compute_oriented(const TriMesh& mesh, const CurvatureOptions& opti
   const double min_area = 1e-14 * box.diagonal() * box.diagonal();
 
   std::vector<FaceFrame> faces(nf);
-  for_range(nf, threaded, [&](std::size_t f) {
+  parallel_for_each(nf, [&](std::size_t f) {
     const auto p = face_points(mesh, f);
     FaceFrame& ff = faces[f];
     ff.edge = {p[2] - p[1], p[0] - p[2], p[1] - p[0]};
@@ -264,7 +251,7 @@ MeshCurvature compute_oriented(const TriMesh& mesh, const CurvatureOptions& opti
     ff.t = normalize(ff.edge[0]);
     ff.b = normalize(cross(n, ff.t));
     ff.corner_area = corner_areas(ff.edge, area);
-  });
+  }, threaded, std::size_t(1024));
   for (const FaceFrame& ff : faces) out.degenerate_faces += ff.is_degenerate ? 1 : 0;
 
   const VertexFaces vf = build_vertex_faces(mesh);
@@ -273,7 +260,7 @@ MeshCurvature compute_oriented(const TriMesh& mesh, const CurvatureOptions& opti
   out.is_valid.assign(nv, 0);
   std::vector<VertexKind> kind(nv);
   std::vector<Vec3d> normal(nv), u(nv), v(nv);
-  for_range(nv, threaded, [&](std::size_t vi) {
+  parallel_for_each(nv, [&](std::size_t vi) {
     kind[vi] = classify_vertex(mesh, vf.of(vi), faces);
     Vec3d n{};
     double area = 0;
@@ -292,19 +279,19 @@ MeshCurvature compute_oriented(const TriMesh& mesh, const CurvatureOptions& opti
     const bool is_manifold = kind[vi] == VertexKind::Interior || kind[vi] == VertexKind::Boundary;
     out.is_valid[vi] = (is_manifold && length(normal[vi]) > 0) ? 1 : 0;
     out.normals[vi] = out.is_valid[vi] ? Vec3f(normal[vi]) : Vec3f{};
-  });
+  }, threaded, std::size_t(1024));
   for (std::size_t vi = 0; vi < nv; ++vi) {
     out.boundary_vertices += kind[vi] == VertexKind::Boundary ? 1 : 0;
     out.nonmanifold_vertices += kind[vi] == VertexKind::NonManifold ? 1 : 0;
     out.unreferenced_vertices += kind[vi] == VertexKind::Isolated ? 1 : 0;
   }
-  for_range(nf, threaded, [&](std::size_t f) {
+  parallel_for_each(nf, [&](std::size_t f) {
     const auto& t = mesh.triangles[f];
     faces[f].is_fitted = !faces[f].is_degenerate && out.is_valid[t[0]] && out.is_valid[t[1]] && out.is_valid[t[2]];
-  });
+  }, threaded, std::size_t(1024));
 
   // Initial vertex frames: an incident edge made perpendicular to the normal (trimesh2).
-  for_range(nv, threaded, [&](std::size_t vi) {
+  parallel_for_each(nv, [&](std::size_t vi) {
     for (std::uint32_t c : vf.of(vi)) {
       if (!out.is_valid[vi] || faces[c / 3].is_degenerate) continue;
       const Vec3d e = faces[c / 3].edge[(c % 3 + 2) % 3];  // from this corner to the next
@@ -312,11 +299,11 @@ MeshCurvature compute_oriented(const TriMesh& mesh, const CurvatureOptions& opti
       if (length(u[vi]) > 0) break;
     }
     v[vi] = cross(normal[vi], u[vi]);
-  });
+  }, threaded, std::size_t(1024));
 
   // Second fundamental form per face from normal differences along the edges.
   std::vector<Tensor> face_ii(nf);
-  for_range(nf, threaded, [&](std::size_t f) {
+  parallel_for_each(nf, [&](std::size_t f) {
     FaceFrame& ff = faces[f];
     if (!ff.is_fitted) return;
     const auto& tri = mesh.triangles[f];
@@ -343,7 +330,7 @@ MeshCurvature compute_oriented(const TriMesh& mesh, const CurvatureOptions& opti
       return;
     }
     face_ii[f] = {x[0], x[1], x[2]};
-  });
+  }, threaded, std::size_t(1024));
 
   // Gather into vertex frames with corner-area weights, then diagonalise (one Jacobi rotation).
   out.k1.assign(nv, 0.0f);
@@ -351,7 +338,7 @@ MeshCurvature compute_oriented(const TriMesh& mesh, const CurvatureOptions& opti
   out.dir1.assign(nv, Vec3f{});
   out.dir2.assign(nv, Vec3f{});
   std::vector<Vec3d> d1(nv), d2(nv);
-  for_range(nv, threaded, [&](std::size_t vi) {
+  parallel_for_each(nv, [&](std::size_t vi) {
     if (!out.is_valid[vi]) return;
     Tensor k{0, 0, 0};
     double weight = 0;
@@ -388,12 +375,12 @@ MeshCurvature compute_oriented(const TriMesh& mesh, const CurvatureOptions& opti
     out.k2[vi] = float(k2);
     out.dir1[vi] = Vec3f(d1[vi]);
     out.dir2[vi] = Vec3f(d2[vi]);
-  });
+  }, threaded, std::size_t(1024));
 
   // Derivative tensor per face from curvature-tensor differences along the edges.
   std::vector<DTensor> face_c(nf);
   std::vector<std::uint8_t> has_c(nf, 0);
-  for_range(nf, threaded, [&](std::size_t f) {
+  parallel_for_each(nf, [&](std::size_t f) {
     const FaceFrame& ff = faces[f];
     if (!ff.is_fitted) return;
     const auto& tri = mesh.triangles[f];
@@ -428,9 +415,9 @@ MeshCurvature compute_oriented(const TriMesh& mesh, const CurvatureOptions& opti
     if (!solve_ldlt<4>(w, m, x)) return;
     face_c[f] = {x[0], x[1], x[2], x[3]};
     has_c[f] = 1;
-  });
+  }, threaded, std::size_t(1024));
   out.dcurv.assign(nv, {0, 0, 0, 0});
-  for_range(nv, threaded, [&](std::size_t vi) {
+  parallel_for_each(nv, [&](std::size_t vi) {
     if (!out.is_valid[vi]) return;
     DTensor sum{0, 0, 0, 0};
     double weight = 0;
@@ -443,7 +430,7 @@ MeshCurvature compute_oriented(const TriMesh& mesh, const CurvatureOptions& opti
       weight += wt;
     }
     for (int i = 0; i < 4; ++i) out.dcurv[vi][i] = weight > 0 ? float(sum[i] / weight) : 0.0f;
-  });
+  }, threaded, std::size_t(1024));
 
   for (std::size_t vi = 0; vi < nv; ++vi) {
     const auto& c = out.dcurv[vi];
