@@ -4,10 +4,10 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <sstream>
 #include <vector>
 
+#include "core/colour.h"
 #include "core/errors.h"
 #include "core/parallel.h"
 
@@ -133,41 +133,13 @@ std::array<Plane, 3> downscale_rgb(const ImageRGBA& image, int w, int h, bool th
   return out;
 }
 
-/// Cube root of t > 0 for CIELAB: a bit-trick estimate (within 3.3 %) refined by two Halley steps
-/// (cubic convergence, relative error below 1e-12); std::cbrt was the most expensive call of the map.
-double cube_root(double t) {
-  std::uint64_t bits = 0;
-  std::memcpy(&bits, &t, sizeof bits);
-  bits = bits / 3 + 0x2A9F7893782DA1CEull;
-  double y = 0;
-  std::memcpy(&y, &bits, sizeof y);
-  for (int i = 0; i < 2; ++i) {
-    const double y3 = y * y * y;
-    y *= (y3 + 2.0 * t) / (2.0 * y3 + t);
-  }
-  return y;
-}
-
 /// Linear sRGB primaries -> CIELAB (D65 white), in place: planes become L*, a*, b*.
 void rgb_to_lab(std::array<Plane, 3>& planes, bool threaded) {
-  constexpr double kXn = 0.95047, kYn = 1.0, kZn = 1.08883;
-  constexpr double kDelta = 6.0 / 29.0;
-  const auto f = [](double t) {
-    return t > kDelta * kDelta * kDelta ? cube_root(t) : t / (3.0 * kDelta * kDelta) + 4.0 / 29.0;
-  };
   const int w = planes[0].width;
   parallel_rows(planes[0].height, [&](int y) {
     for (int x = 0; x < w; ++x) {
-      // Negative linear values (out-of-gamut renders) have no colorimetric meaning: clamp to black.
-      const double r = std::max(0.0f, planes[0](x, y));
-      const double g = std::max(0.0f, planes[1](x, y));
-      const double b = std::max(0.0f, planes[2](x, y));
-      const double fx = f((0.4124564 * r + 0.3575761 * g + 0.1804375 * b) / kXn);
-      const double fy = f((0.2126729 * r + 0.7151522 * g + 0.0721750 * b) / kYn);
-      const double fz = f((0.0193339 * r + 0.1191920 * g + 0.9503041 * b) / kZn);
-      planes[0](x, y) = float(116.0 * fy - 16.0);
-      planes[1](x, y) = float(500.0 * (fx - fy));
-      planes[2](x, y) = float(200.0 * (fy - fz));
+      const Colour3 lab = linear_srgb_to_cielab({planes[0](x, y), planes[1](x, y), planes[2](x, y)});
+      for (int c = 0; c < 3; ++c) planes[std::size_t(c)](x, y) = float(lab[std::size_t(c)]);
     }
   }, threaded);
 }

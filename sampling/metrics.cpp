@@ -8,6 +8,7 @@
 #include <limits>
 #include <vector>
 
+#include "core/colour.h"
 #include "core/parallel.h"
 
 namespace raysift::sampling {
@@ -40,43 +41,21 @@ std::array<float, 3> display_rgb(const Rgba& p) {
   return {linear_to_srgb(p.r), linear_to_srgb(p.g), linear_to_srgb(p.b)};
 }
 
-// ---- FLIP colour spaces (linear sRGB primaries, D65) ----
-using Mat3 = std::array<std::array<double, 3>, 3>;
+// ---- FLIP colour spaces (core/colour.h's linear sRGB and XYZ, in float as in FLIP) ----
 using Col3 = std::array<float, 3>;
-
-constexpr Mat3 kRgbToXyz = {{{10135552.0 / 24577794.0, 8788810.0 / 24577794.0, 4435075.0 / 24577794.0},
-                             {2613072.0 / 12288897.0, 8788810.0 / 12288897.0, 887015.0 / 12288897.0},
-                             {1425312.0 / 73733382.0, 8788810.0 / 73733382.0, 70074185.0 / 73733382.0}}};
-
-Mat3 inverse(const Mat3& m) {
-  const double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
-                     m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-                     m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-  Mat3 r{};
-  r[0][0] = (m[1][1] * m[2][2] - m[1][2] * m[2][1]) / det;
-  r[0][1] = (m[0][2] * m[2][1] - m[0][1] * m[2][2]) / det;
-  r[0][2] = (m[0][1] * m[1][2] - m[0][2] * m[1][1]) / det;
-  r[1][0] = (m[1][2] * m[2][0] - m[1][0] * m[2][2]) / det;
-  r[1][1] = (m[0][0] * m[2][2] - m[0][2] * m[2][0]) / det;
-  r[1][2] = (m[0][2] * m[1][0] - m[0][0] * m[1][2]) / det;
-  r[2][0] = (m[1][0] * m[2][1] - m[1][1] * m[2][0]) / det;
-  r[2][1] = (m[0][1] * m[2][0] - m[0][0] * m[2][1]) / det;
-  r[2][2] = (m[0][0] * m[1][1] - m[0][1] * m[1][0]) / det;
-  return r;
-}
 
 struct FlipColour {
   std::array<std::array<float, 3>, 3> to_xyz{}, to_rgb{};
   Col3 white{};  // XYZ of linear white (1,1,1): the reference illuminant
 
   FlipColour() {
-    const Mat3 inv = inverse(kRgbToXyz);
+    const Colour3 w = d65_white_xyz();
     for (int i = 0; i < 3; ++i) {
       for (int j = 0; j < 3; ++j) {
-        to_xyz[i][j] = float(kRgbToXyz[i][j]);
-        to_rgb[i][j] = float(inv[i][j]);
+        to_xyz[i][j] = float(kLinearSrgbToXyz[i][j]);
+        to_rgb[i][j] = float(xyz_to_linear_srgb_matrix()[i][j]);
       }
-      white[i] = float(kRgbToXyz[i][0] + kRgbToXyz[i][1] + kRgbToXyz[i][2]);
+      white[i] = float(w[i]);
     }
   }
   static Col3 apply(const std::array<std::array<float, 3>, 3>& m, const Col3& v) {
@@ -93,14 +72,9 @@ struct FlipColour {
     const Col3 xyz = {(y + c[1] / 500.0f) * white[0], y * white[1], (y - c[2] / 200.0f) * white[2]};
     return apply(to_rgb, xyz);
   }
-  Col3 rgb_to_lab(const Col3& rgb) const {
-    const Col3 xyz = apply(to_xyz, rgb);
-    constexpr float delta = 6.0f / 29.0f;
-    auto f = [&](float t) {
-      return t > delta * delta * delta ? std::cbrt(t) : t / (3.0f * delta * delta) + 4.0f / 29.0f;
-    };
-    const float fx = f(xyz[0] / white[0]), fy = f(xyz[1] / white[1]), fz = f(xyz[2] / white[2]);
-    return {116.0f * fy - 16.0f, 500.0f * (fx - fy), 200.0f * (fy - fz)};
+  static Col3 rgb_to_lab(const Col3& rgb) {
+    const Colour3 lab = linear_srgb_to_cielab({rgb[0], rgb[1], rgb[2]});
+    return {float(lab[0]), float(lab[1]), float(lab[2])};
   }
   // Hunt-adjusted Lab: chroma scaled by 0.01 L*.
   Col3 hunt_lab(const Col3& rgb) const {
