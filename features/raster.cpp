@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/tolerances.h"
 #include "core/parallel.h"
 
 namespace raysift::features {
@@ -163,8 +164,7 @@ DepthBuffer rasterize_depth(const TriMesh& mesh, const Camera& camera, const Ras
       box.expand(Vec3d(mesh.positions[v]));
     }
   if (mesh.empty()) return out;
-  // Relative to the scene size: closer than this to the eye plane a vertex is clipped away.
-  const double near = std::max(1e-6 * box.diagonal(), 1e-30);
+  const double near = std::max(tol::kNearPlaneRelative * box.diagonal(), 1e-30);
   const double tan_y = std::tan(camera.spec().fov_y_deg * M_PI / 360.0);
   const double tan_x = tan_y * double(width) / double(height);
 

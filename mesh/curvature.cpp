@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/errors.h"
+#include "core/tolerances.h"
 #include "core/parallel.h"
 #include "core/span.h"
 
@@ -245,12 +246,12 @@ struct CurvatureWork {
   void for_vertices(const F& f) const { parallel_for_each(mesh.vertex_count(), f, threaded, kGrain); }
 };
 
-/// Edges, tangent frame and corner areas per face; faces below rounding-noise area (relative to the squared
-/// bbox diagonal) or with a repeated vertex stay degenerate.
+/// Edges, tangent frame and corner areas per face; faces below rounding-noise area or with a repeated vertex
+/// stay degenerate.
 void compute_face_frames(CurvatureWork& w, MeshCurvature& out) {
   Bbox3d box;
   for (const Vec3f& p : w.mesh.positions) box.expand(Vec3d(p));
-  const double min_area = 1e-14 * box.diagonal() * box.diagonal();
+  const double min_area = tol::kDegenerateAreaRelative * box.diagonal() * box.diagonal();
   w.faces.assign(w.mesh.triangle_count(), FaceFrame{});
   w.for_faces([&](std::size_t f) {
     const auto p = face_points(w.mesh, f);
