@@ -107,7 +107,7 @@ VtkResult vtk_flying_edges(const std::string& raw, const Vec3i& dims, const std:
   return r;
 }
 
-void bench(const Case& c, double iso, int runs, int threads, bool ours_only) {
+void bench_case(const Case& c, double iso, int runs, int threads, bool ours_only) {
   std::size_t ours_tris = 0;
   auto ours = [&] { ours_tris = volume::extract_isosurface(c.volume, iso).triangle_count(); };
   if (ours_only) {
@@ -216,6 +216,6 @@ int main(int argc, char** argv) {
   const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
   std::printf("fastest of %d runs (ours: of 2 x %d, before and after the references), %d threads for ours, OpenVDB (TBB) and VTK (vtkSMPTools)\n", runs, runs, threads);
   for (const Case& c : cases)
-    for (const double iso : c.isos) bench(c, iso, runs, threads, ours_only);
+    for (const double iso : c.isos) bench_case(c, iso, runs, threads, ours_only);
   return 0;
 }

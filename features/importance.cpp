@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/bilinear.h"
 #include "core/errors.h"
 #include "core/parallel.h"
 #include "core/timer.h"
@@ -178,37 +179,18 @@ ImageF upsample_importance(const ImportanceBuffer& buffer, bool threaded) {
   const ImageF& v = buffer.values;
   const int w = buffer.frame_width, h = buffer.frame_height;
   ImageF out(w, h, 0.0f);
-  // Per frame column: the two buffer columns around its centre and the weight of the right one (the
-  // same clamped coordinates as sample_importance).
-  std::vector<int> x0(std::size_t(w), 0), x1(std::size_t(w), 0);
-  std::vector<float> tx(std::size_t(w), 0.0f);
-  for (int x = 0; x < w; ++x) {
-    const double fx = (x + 0.5) * v.width / w - 0.5;
-    const int i = int(std::floor(fx));
-    x0[std::size_t(x)] = std::clamp(i, 0, v.width - 1);
-    x1[std::size_t(x)] = std::clamp(i + 1, 0, v.width - 1);
-    tx[std::size_t(x)] = float(fx - i);
-  }
+  // The same clamped coordinates as sample_importance.
+  const BilinearTaps tx = bilinear_taps(w, v.width), ty = bilinear_taps(h, v.height);
   std::vector<std::uint8_t> row_has_background(std::size_t(v.height), 0);
   for (int y = 0; y < v.height; ++y)
     for (int x = 0; x < v.width; ++x) row_has_background[std::size_t(y)] |= v(x, y) < 0 ? 1 : 0;
   parallel_rows(h, [&](int y) {
-    const double fy = (y + 0.5) * v.height / h - 0.5;
-    const int j = int(std::floor(fy));
-    const int y0 = std::clamp(j, 0, v.height - 1), y1 = std::clamp(j + 1, 0, v.height - 1);
-    if (row_has_background[std::size_t(y0)] || row_has_background[std::size_t(y1)]) {
+    const std::size_t j = std::size_t(y);
+    if (row_has_background[std::size_t(ty.lo[j])] || row_has_background[std::size_t(ty.hi[j])]) {
       for (int x = 0; x < w; ++x) out(x, y) = sample_importance(buffer, x, y);
       return;
     }
-    const float ty = float(fy - j);
-    const float* r0 = &v(0, y0);
-    const float* r1 = &v(0, y1);
-    float* o = &out(0, y);
-    for (int x = 0; x < w; ++x) {
-      const std::size_t i = std::size_t(x);
-      const float a = r0[x0[i]] + (r1[x0[i]] - r0[x0[i]]) * ty, b = r0[x1[i]] + (r1[x1[i]] - r0[x1[i]]) * ty;
-      o[x] = a + (b - a) * tx[i];
-    }
+    for (int x = 0; x < w; ++x) out(x, y) = bilinear_at(v, tx, ty, x, y);
   }, threaded);
   return out;
 }

@@ -1,6 +1,7 @@
 #include "features/raster.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -137,6 +138,37 @@ struct ViewPoint {
   double x, y, z;  // along right, image up, forward (z = view depth)
 };
 
+/// The bounding box of the used vertices. \throw InvalidInput for an index out of range or a NaN/Inf vertex.
+Bbox3d checked_bounds(const TriMesh& mesh) {
+  Bbox3d box;
+  for (std::size_t f = 0; f < mesh.triangle_count(); ++f)
+    for (std::uint32_t v : mesh.triangles[f]) {
+      if (v >= mesh.vertex_count())
+        throw InvalidInput("rasterize: triangle " + std::to_string(f) + " references vertex " + std::to_string(v) +
+                           " of " + std::to_string(mesh.vertex_count()));
+      if (!is_finite(mesh.positions[v]))
+        throw InvalidInput("rasterize: vertex " + std::to_string(v) + " has a NaN or infinite coordinate");
+      box.expand(Vec3d(mesh.positions[v]));
+    }
+  return box;
+}
+
+/// The part of triangle `tri` at or beyond view depth `near`, as a polygon of up to 4 corners in order;
+/// returns the corner count (0 when the triangle lies wholly in front of the near plane).
+int clip_to_near(const std::array<ViewPoint, 3>& tri, double near, ViewPoint (&poly)[4]) {
+  int n = 0;
+  for (int k = 0; k < 3; ++k) {
+    const ViewPoint& p = tri[std::size_t(k)];
+    const ViewPoint& q = tri[std::size_t((k + 1) % 3)];
+    if (p.z >= near) poly[n++] = p;
+    if ((p.z >= near) != (q.z >= near)) {
+      const double s = (near - p.z) / (q.z - p.z);
+      poly[n++] = {p.x + s * (q.x - p.x), p.y + s * (q.y - p.y), near};
+    }
+  }
+  return n;
+}
+
 
 }  // namespace
 
@@ -153,16 +185,7 @@ DepthBuffer rasterize_depth(const TriMesh& mesh, const Camera& camera, const Ras
   const int width = camera.width(), height = camera.height();
   DepthBuffer out{camera.spec(), ImageF(width, height, std::numeric_limits<float>::infinity()),
                   ImageU32(width, height, kNoFace)};
-  Bbox3d box;
-  for (std::size_t f = 0; f < mesh.triangle_count(); ++f)
-    for (std::uint32_t v : mesh.triangles[f]) {
-      if (v >= mesh.vertex_count())
-        throw InvalidInput("rasterize: triangle " + std::to_string(f) + " references vertex " + std::to_string(v) +
-                           " of " + std::to_string(mesh.vertex_count()));
-      if (!is_finite(mesh.positions[v]))
-        throw InvalidInput("rasterize: vertex " + std::to_string(v) + " has a NaN or infinite coordinate");
-      box.expand(Vec3d(mesh.positions[v]));
-    }
+  const Bbox3d box = checked_bounds(mesh);
   if (mesh.empty()) return out;
   const double near = std::max(tol::kNearPlaneRelative * box.diagonal(), 1e-30);
   const double tan_y = std::tan(camera.spec().fov_y_deg * M_PI / 360.0);
@@ -205,16 +228,7 @@ DepthBuffer rasterize_depth(const TriMesh& mesh, const Camera& camera, const Ras
         continue;
       }
       ViewPoint poly[4];
-      int n = 0;
-      for (int k = 0; k < 3 && in_front > 0; ++k) {
-        const ViewPoint& p = view[t[k]];
-        const ViewPoint& q = view[t[(k + 1) % 3]];
-        if (p.z >= near) poly[n++] = p;
-        if ((p.z >= near) != (q.z >= near)) {
-          const double s = (near - p.z) / (q.z - p.z);
-          poly[n++] = {p.x + s * (q.x - p.x), p.y + s * (q.y - p.y), near};
-        }
-      }
+      const int n = in_front > 0 ? clip_to_near({view[t[0]], view[t[1]], view[t[2]]}, near, poly) : 0;
       ScreenPoint sp[4];
       for (int k = 0; k < n; ++k) sp[k] = to_screen(poly[k]);
       for (int k = 1; k + 1 < n; ++k) add(&sp[0], &sp[k], &sp[k + 1], std::uint32_t(f));

@@ -318,6 +318,43 @@ struct FeatureSpec {
   int surround;
 };
 
+/// pyramids[channel][level]; channels 0..2 = L*, a*, b* (consumed from `lab`), then one per Gabor orientation.
+std::vector<std::vector<Plane>> build_pyramids(std::array<Plane, 3>& lab, bool use_orientation, bool threaded) {
+  const int n_channels = use_orientation ? 3 + kOrientations : 3;
+  std::vector<std::vector<Plane>> pyramids{std::size_t(n_channels)};
+  for (int c = 0; c < 3; ++c) {
+    auto& levels = pyramids[std::size_t(c)];
+    levels.push_back(std::move(lab[std::size_t(c)]));
+    while (int(levels.size()) < kMaxLevels && std::min(levels.back().width, levels.back().height) > 1)
+      levels.push_back(reduce(levels.back(), threaded));
+  }
+  const int n_levels = int(pyramids[0].size());
+  if (use_orientation) {
+    // Level 0 takes part in no centre-surround pair, so its Gabor response is never needed.
+    for (int o = 0; o < kOrientations; ++o) {
+      const Kernel kernel = gabor_kernel(M_PI * o / kOrientations);
+      auto& levels = pyramids[std::size_t(3 + o)];
+      levels.resize(std::size_t(n_levels));
+      for (int l = 1; l < n_levels; ++l) levels[std::size_t(l)] = gabor_energy(pyramids[0][std::size_t(l)], kernel, threaded);
+    }
+  }
+  return pyramids;
+}
+
+/// Every (channel, centre, surround) feature map, with the surround capped at the coarsest level.
+std::vector<FeatureSpec> feature_specs(int n_channels, int n_levels) {
+  std::vector<std::pair<int, int>> pairs;
+  for (int c : kCentreLevels)
+    for (int d : kSurroundDeltas) {
+      const int s = std::min(c + d, n_levels - 1);
+      if (s > c && std::find(pairs.begin(), pairs.end(), std::make_pair(c, s)) == pairs.end()) pairs.emplace_back(c, s);
+    }
+  std::vector<FeatureSpec> specs;
+  for (int ch = 0; ch < n_channels; ++ch)
+    for (const auto& [c, s] : pairs) specs.push_back({ch, c, s});
+  return specs;
+}
+
 }  // namespace
 
 int saliency_map_side(int image_side, double scale) {
@@ -334,35 +371,8 @@ ImageF compute_saliency(const ImageRGBA& image, const SaliencyOptions& options) 
   require_finite(lab, image);
   rgb_to_lab(lab, threaded);
 
-  // pyramids[channel][level]; channels 0..2 = L*, a*, b*, then one per Gabor orientation.
-  const int n_channels = options.use_orientation ? 3 + kOrientations : 3;
-  std::vector<std::vector<Plane>> pyramids{std::size_t(n_channels)};
-  for (int c = 0; c < 3; ++c) {
-    auto& levels = pyramids[std::size_t(c)];
-    levels.push_back(std::move(lab[std::size_t(c)]));
-    while (int(levels.size()) < kMaxLevels && std::min(levels.back().width, levels.back().height) > 1)
-      levels.push_back(reduce(levels.back(), threaded));
-  }
-  const int n_levels = int(pyramids[0].size());
-  if (options.use_orientation) {
-    // Level 0 takes part in no centre-surround pair, so its Gabor response is never needed.
-    for (int o = 0; o < kOrientations; ++o) {
-      const Kernel kernel = gabor_kernel(M_PI * o / kOrientations);
-      auto& levels = pyramids[std::size_t(3 + o)];
-      levels.resize(std::size_t(n_levels));
-      for (int l = 1; l < n_levels; ++l) levels[std::size_t(l)] = gabor_energy(pyramids[0][std::size_t(l)], kernel, threaded);
-    }
-  }
-
-  std::vector<std::pair<int, int>> pairs;
-  for (int c : kCentreLevels)
-    for (int d : kSurroundDeltas) {
-      const int s = std::min(c + d, n_levels - 1);
-      if (s > c && std::find(pairs.begin(), pairs.end(), std::make_pair(c, s)) == pairs.end()) pairs.emplace_back(c, s);
-    }
-  std::vector<FeatureSpec> specs;
-  for (int ch = 0; ch < n_channels; ++ch)
-    for (const auto& [c, s] : pairs) specs.push_back({ch, c, s});
+  const std::vector<std::vector<Plane>> pyramids = build_pyramids(lab, options.use_orientation, threaded);
+  const std::vector<FeatureSpec> specs = feature_specs(int(pyramids.size()), int(pyramids[0].size()));
 
   // Each feature map is an independent task writing only its own slot; the sums below run in a
   // fixed order, so the result does not depend on scheduling.
