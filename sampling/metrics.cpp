@@ -102,6 +102,15 @@ using Three = std::array<float, 3>;
 
 std::size_t at(int w, int x, int y) { return std::size_t(y) * std::size_t(w) + std::size_t(x); }
 
+/// One separable filter pass at position `pos` of an axis of n pixels: tap(acc, fi, i) for the taps fi in
+/// [0, 2 radius] in order, i the neighbour index clamped to the axis (borders replicated).
+template <typename Acc, typename F>
+Acc filter_at(int radius, int pos, int n, const F& tap) {
+  Acc acc{};
+  for (int k = -radius; k <= radius; ++k) tap(acc, k + radius, std::min(std::max(0, pos + k), n - 1));
+  return acc;
+}
+
 /// Linear RGB clamped to [0,1], then YCxCz.
 std::vector<Col3> to_ycxcz(const ImageRGBA& image) {
   static const FlipColour colour;
@@ -148,17 +157,14 @@ struct CsfFilters {
 /// Horizontal CSF pass: Y, Cx, Cz-part-1, Cz-part-2 per pixel (borders replicated).
 std::vector<Four> csf_rows(const std::vector<Col3>& ycc, int w, int h, const CsfFilters& f) {
   std::vector<Four> mid(ycc.size());
-  parallel_pixels(w, h, [&, r = f.radius](int x, int y) {
-    Four m{};
-    for (int k = -r; k <= r; ++k) {
-      const Col3& c = ycc[at(w, std::min(std::max(0, x + k), w - 1), y)];
-      const int fi = k + r;
+  parallel_pixels(w, h, [&](int x, int y) {
+    mid[at(w, x, y)] = filter_at<Four>(f.radius, x, w, [&](Four& m, int fi, int xx) {
+      const Col3& c = ycc[at(w, xx, y)];
       m[0] += f.y[fi] * c[0];
       m[1] += f.cx[fi] * c[1];
       m[2] += f.cz1[fi] * c[2];
       m[3] += f.cz2[fi] * c[2];
-    }
-    mid[at(w, x, y)] = m;
+    });
   });
   return mid;
 }
@@ -166,15 +172,13 @@ std::vector<Four> csf_rows(const std::vector<Col3>& ycc, int w, int h, const Csf
 /// Vertical CSF pass at one pixel, back to linear RGB clamped to [0,1], as Hunt-adjusted Lab.
 Col3 csf_column_hunt_lab(const std::vector<Four>& mid, int w, int h, const CsfFilters& f, int x, int y) {
   static const FlipColour colour;
-  Four m{};
-  for (int k = -f.radius; k <= f.radius; ++k) {
-    const Four& c = mid[at(w, x, std::min(std::max(0, y + k), h - 1))];
-    const int fi = k + f.radius;
-    m[0] += f.y[fi] * c[0];
-    m[1] += f.cx[fi] * c[1];
-    m[2] += f.cz1[fi] * c[2];
-    m[3] += f.cz2[fi] * c[3];
-  }
+  const Four m = filter_at<Four>(f.radius, y, h, [&](Four& acc, int fi, int yy) {
+    const Four& c = mid[at(w, x, yy)];
+    acc[0] += f.y[fi] * c[0];
+    acc[1] += f.cx[fi] * c[1];
+    acc[2] += f.cz1[fi] * c[2];
+    acc[3] += f.cz2[fi] * c[3];
+  });
   Col3 rgb = colour.ycxcz_to_rgb({m[0], m[1], m[2] + m[3]});
   for (float& c : rgb) c = std::min(1.0f, std::max(0.0f, c));
   return colour.hunt_lab(rgb);
@@ -229,32 +233,26 @@ struct FeatureFilters {
 /// Horizontal feature pass on the achromatic channel normalised to [0,1]: d/dx, d2/dx2, Gaussian along x.
 std::vector<Three> feature_rows(const std::vector<Col3>& ycc, int w, int h, const FeatureFilters& f) {
   std::vector<Three> out(ycc.size());
-  parallel_pixels(w, h, [&, r = f.radius](int x, int y) {
-    Three t{};
-    for (int k = -r; k <= r; ++k) {
-      const float v = (ycc[at(w, std::min(std::max(0, x + k), w - 1), y)][0] + 16.0f) / 116.0f;
-      const int fi = k + r;
+  parallel_pixels(w, h, [&](int x, int y) {
+    out[at(w, x, y)] = filter_at<Three>(f.radius, x, w, [&](Three& t, int fi, int xx) {
+      const float v = (ycc[at(w, xx, y)][0] + 16.0f) / 116.0f;
       t[0] += f.dg[fi] * v;
       t[1] += f.ddg[fi] * v;
       t[2] += f.g[fi] * v;
-    }
-    out[at(w, x, y)] = t;
+    });
   });
   return out;
 }
 
 /// Vertical feature pass at one pixel: {dx, ddx, dy, ddy}.
 Four feature_column(const std::vector<Three>& rows, int w, int h, const FeatureFilters& f, int x, int y) {
-  Four d{};
-  for (int k = -f.radius; k <= f.radius; ++k) {
-    const Three& t = rows[at(w, x, std::min(std::max(0, y + k), h - 1))];
-    const int fi = k + f.radius;
+  return filter_at<Four>(f.radius, y, h, [&](Four& d, int fi, int yy) {
+    const Three& t = rows[at(w, x, yy)];
     d[0] += f.g[fi] * t[0];
     d[1] += f.g[fi] * t[1];
     d[2] += f.dg[fi] * t[2];
     d[3] += f.ddg[fi] * t[2];
-  }
-  return d;
+  });
 }
 
 }  // namespace
