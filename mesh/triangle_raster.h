@@ -114,11 +114,13 @@ inline bool set_up_triangle(const double (&x)[3], const double (&y)[3], const do
 
 /// Whether the triangle covers the pixel centre (px, py) under the top-left rule.
 inline bool covers(const RasterTriangle& t, double px, double py) {
+  // One edge at a time: most tested centres of small triangles fail the first or second edge.
   const double w0 = edge_function(t.x1, t.y1, t.x2, t.y2, px, py);
+  if (w0 < 0.0 || (w0 == 0.0 && !t.own[0])) return false;
   const double w1 = edge_function(t.x2, t.y2, t.x0, t.y0, px, py);
+  if (w1 < 0.0 || (w1 == 0.0 && !t.own[1])) return false;
   const double w2 = edge_function(t.x0, t.y0, t.x1, t.y1, px, py);
-  if (w0 < 0.0 || w1 < 0.0 || w2 < 0.0) return false;
-  return !((w0 == 0.0 && !t.own[0]) || (w1 == 0.0 && !t.own[1]) || (w2 == 0.0 && !t.own[2]));
+  return !(w2 < 0.0 || (w2 == 0.0 && !t.own[2]));
 }
 
 /// Calls fragment(col, row, inv_z) for every pixel centre in columns [c0, c1] and rows [r0, r1] that the
@@ -137,11 +139,22 @@ void draw_triangle(const RasterTriangle& t, int c0, int c1, int r0, int r1, cons
       narrow_to_edge(t.x2, t.y2, t.x0, t.y0, t.inv_slope[1], t.rounding, py, lo, hi, inner_lo, inner_hi);
       narrow_to_edge(t.x0, t.y0, t.x1, t.y1, t.inv_slope[2], t.rounding, py, lo, hi, inner_lo, inner_hi);
     }
-    if (inner_lo > inner_hi) inner_lo = inner_hi = hi + 1;  // no sure interior: test every column
-    for (int col = lo; col <= hi; ++col) {
-      const double px = col + 0.5;
-      if ((col >= inner_lo && col <= inner_hi) || covers(t, px, py)) fragment(col, row, t.ia * px + row_iz);
+    // Columns [lo, hi] in three runs: tested, surely covered, tested.
+    inner_lo = std::max(inner_lo, lo);
+    inner_hi = std::min(inner_hi, hi);
+    if (inner_lo > inner_hi) {  // no sure interior: test every column
+      inner_lo = hi + 1;
+      inner_hi = hi;
     }
+    auto tested = [&](int first, int last) {
+      for (int col = first; col <= last; ++col) {
+        const double px = col + 0.5;
+        if (covers(t, px, py)) fragment(col, row, t.ia * px + row_iz);
+      }
+    };
+    tested(lo, inner_lo - 1);
+    for (int col = inner_lo; col <= inner_hi; ++col) fragment(col, row, t.ia * (col + 0.5) + row_iz);
+    tested(inner_hi + 1, hi);
   }
 }
 
