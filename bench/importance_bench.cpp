@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_data.h"
 #include "core/json_io.h"
 #include "core/timer.h"
 #include "features/importance.h"
@@ -40,7 +41,7 @@ struct SceneCase {
 };
 
 CameraSpec load_camera(const SceneCase& c, int width, int height) {
-  const std::string dir = std::string(RAYSIFT_SOURCE_DIR) + "/datasets/";
+  const std::string dir = raysift::bench::bundled_datasets_dir();
   CameraSpec cam = camera_spec_from_json(read_json_file(dir + c.camera), dir + c.camera);
   cam.width = width;
   cam.height = height;
@@ -161,7 +162,7 @@ int main(int argc, char** argv) {
     std::printf("importance_bench: features %s, importance scale %g, %d threads, medians of %d rounds (wall ms; "
                 "ratios also in process CPU time, which the machine's load changes less)\n",
                 feature_list.c_str(), scale, tbb::this_task_arena::max_concurrency(), rounds);
-    const std::string dir = std::string(RAYSIFT_SOURCE_DIR) + "/datasets/";
+    const std::string dir = raysift::bench::bundled_datasets_dir();
     const std::vector<SceneCase> cases = {
         {"engine_opaque", "engine_ct.vdb", "engine_ct_tf.json", "engine_ct_camera.json", false},
         {"engine_translucent", "engine_ct.vdb", "engine_ct_tf_translucent.json", "engine_ct_camera.json", true},

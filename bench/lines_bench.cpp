@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_data.h"
 #include "core/camera.h"
 #include "core/json_io.h"
 #include "core/timer.h"
@@ -154,7 +155,7 @@ struct FullRender {
 };
 
 void engine_case() {
-  const std::string dir = std::string(RAYSIFT_SOURCE_DIR) + "/datasets/";
+  const std::string dir = raysift::bench::bundled_datasets_dir();
   if (!std::filesystem::exists(dir + "engine_ct.vdb")) {
     std::printf("engine CT: %sengine_ct.vdb not found, skipped\n", dir.c_str());
     return;
@@ -197,7 +198,7 @@ int main(int argc, char** argv) {
   try {
     engine_case();
     const std::string path =
-        argc > 1 ? argv[1] : RAYSIFT_SOURCE_DIR "/../shared/datasets/stanford_bunny_bun_zipper_35947v_69451tri.ply";
+        argc > 1 ? argv[1] : raysift::bench::shared_dataset("stanford_bunny_bun_zipper_35947v_69451tri.ply");
     const TriMesh m = mesh::read_mesh(path);
     Bbox3d box;
     for (const Vec3f& p : m.positions) box.expand(Vec3d(p));

@@ -4,9 +4,9 @@
 // on a shared machine); ours is timed N times before and N times after the references.
 //
 // Usage: marching_cubes_bench [--runs N] [--threads N] [--ours-only] [FILE.vdb:ISO[,ISO...] ...]
-//   Without volume arguments: the bundled engine CT and MRI (RAYSIFT_SOURCE_DIR/datasets), a 256^3 synthetic
-//   fog of Gaussian blobs, and two volumes that are not bundled (the shared folder beside the repository,
-//   RAYSIFT_SOURCE_DIR/../shared/datasets: the OpenVDB smoke sample and the hydrogen orbital), when present.
+//   Without volume arguments: the bundled engine CT and MRI (datasets/), a 256^3 synthetic fog of Gaussian blobs,
+//   and two volumes that are not bundled (bench/bench_data.h: $RAYSIFT_SHARED_DATASETS or ../shared/datasets
+//   beside the repository): the OpenVDB smoke sample and the hydrogen orbital, when present.
 //   --ours-only skips OpenVDB and VTK (for profiling).
 //
 // VTK sees the volume exactly as ours does: the active bounding box, inactive voxels at the background value,
@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_data.h"
 #include "core/timer.h"
 #include "volume/detail/vdb_grid.h"
 #include "volume/generate.h"
@@ -106,7 +107,7 @@ VtkResult vtk_flying_edges(const std::string& raw, const Vec3i& dims, const std:
   return r;
 }
 
-void bench(const Case& c, double iso, int runs, int threads, bool ours_only) {
+void bench_case(const Case& c, double iso, int runs, int threads, bool ours_only) {
   std::size_t ours_tris = 0;
   auto ours = [&] { ours_tris = volume::extract_isosurface(c.volume, iso).triangle_count(); };
   if (ours_only) {
@@ -153,7 +154,7 @@ void add_vdb(std::vector<Case>& cases, const std::string& label, const std::stri
 }
 
 std::vector<Case> default_cases() {
-  const std::string data = RAYSIFT_SOURCE_DIR "/datasets/", shared = RAYSIFT_SOURCE_DIR "/../shared/datasets/";
+  const std::string data = raysift::bench::bundled_datasets_dir(), shared = raysift::bench::shared_datasets_dir();
   std::vector<Case> cases;
   add_vdb(cases, "engine CT 256x256x128", data + "engine_ct.vdb", {80.0, 150.0});
   add_vdb(cases, "MRI head 128x128x84", data + "mri_head.vdb", {40.0, 90.0});
@@ -215,6 +216,6 @@ int main(int argc, char** argv) {
   const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
   std::printf("fastest of %d runs (ours: of 2 x %d, before and after the references), %d threads for ours, OpenVDB (TBB) and VTK (vtkSMPTools)\n", runs, runs, threads);
   for (const Case& c : cases)
-    for (const double iso : c.isos) bench(c, iso, runs, threads, ours_only);
+    for (const double iso : c.isos) bench_case(c, iso, runs, threads, ours_only);
   return 0;
 }

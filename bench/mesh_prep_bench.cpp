@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_data.h"
 #include "core/timer.h"
 #include "mesh/decimation.h"
 #include "mesh/detail/openmesh_convert.h"
@@ -107,7 +108,7 @@ void bench_decimation(const TriMesh& m, const std::string& ply) {
   std::filesystem::remove(vtk_ply);
 }
 
-void bench(const std::string& label, const TriMesh& m, int iterations) {
+void bench_mesh(const std::string& label, const TriMesh& m, int iterations) {
   const double v = double(m.vertex_count());
   std::printf("\n%s: %zu vertices, %zu triangles, %d iterations\n", label.c_str(), m.vertex_count(), m.triangle_count(),
               iterations);
@@ -169,17 +170,17 @@ void throughput_note() {
 int main(int argc, char** argv) {
   const int iterations = argc > 1 ? std::max(1, std::atoi(argv[1])) : 20;
   std::printf("threads: TBB default; load: see uptime\n");
-  const volume::Volume engine = volume::load_vdb(RAYSIFT_SOURCE_DIR "/datasets/engine_ct.vdb");
+  const volume::Volume engine = volume::load_vdb(raysift::bench::bundled_dataset("engine_ct.vdb"));
   for (const double iso : {80.0, 150.0})
-    bench("engine CT iso " + std::to_string(int(iso)) + " (marching cubes)", volume::extract_isosurface(engine, iso),
+    bench_mesh("engine CT iso " + std::to_string(int(iso)) + " (marching cubes)", volume::extract_isosurface(engine, iso),
           iterations);
-  bench("MRI iso 60 (marching cubes)",
-        volume::extract_isosurface(volume::load_vdb(RAYSIFT_SOURCE_DIR "/datasets/mri_head.vdb"), 60.0), iterations);
+  bench_mesh("MRI iso 60 (marching cubes)",
+        volume::extract_isosurface(volume::load_vdb(raysift::bench::bundled_dataset("mri_head.vdb")), 60.0), iterations);
   volume::BlobsOptions blobs;
   blobs.grid.dims = {256, 256, 256};
   blobs.count = 24;
   blobs.sigma_voxels = 14.0;
-  bench("blobs 256^3 iso 0.5 (marching cubes)", volume::extract_isosurface(volume::make_blobs(blobs), 0.5), iterations);
+  bench_mesh("blobs 256^3 iso 0.5 (marching cubes)", volume::extract_isosurface(volume::make_blobs(blobs), 0.5), iterations);
   throughput_note();
   return 0;
 }

@@ -29,9 +29,9 @@ using namespace raysift;
 namespace {
 
 struct BenchOptions {
-  std::string volume = std::string(RAYSIFT_SOURCE_DIR) + "/datasets/engine_ct.vdb";
-  std::string tf = std::string(RAYSIFT_SOURCE_DIR) + "/datasets/engine_ct_tf.json";
-  std::string camera = std::string(RAYSIFT_SOURCE_DIR) + "/datasets/engine_ct_camera.json";
+  std::string volume = raysift::bench::bundled_dataset("engine_ct.vdb");
+  std::string tf = raysift::bench::bundled_dataset("engine_ct_tf.json");
+  std::string camera = raysift::bench::bundled_dataset("engine_ct_camera.json");
   std::string raw = raysift::bench::shared_dataset("engine_ct_256x256x128_u8.raw.gz");
   std::string dims = "256,256,128";
   int width = 1440, height = 900;

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_data.h"
 #include "core/camera.h"
 #include "core/json_io.h"
 #include "core/timer.h"
@@ -133,7 +134,7 @@ int main(int argc, char** argv) {
       args.emplace_back(argv[i]);
     }
   }
-  const std::string data = std::string(RAYSIFT_SOURCE_DIR) + "/datasets/";
+  const std::string data = raysift::bench::bundled_datasets_dir();
   const std::string vdb_path = args.size() > 0 ? args[0] : data + "engine_ct.vdb";
   const std::string tf_path = args.size() > 1 ? args[1] : data + "engine_ct_tf.json";
   const std::string camera_path = args.size() > 2 ? args[2] : data + "engine_ct_camera.json";

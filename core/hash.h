@@ -13,14 +13,22 @@
 
 namespace raysift {
 
-/// splitmix64's output function (Steele, Lea & Flood 2014): a bijective, well-mixed 64-bit hash.
-/// mix64(0) is splitmix64's first output for seed 0.
-constexpr std::uint64_t mix64(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ull;
+/// splitmix64's increment (2^64 / golden ratio, odd).
+inline constexpr std::uint64_t kSplitmixGamma = 0x9e3779b97f4a7c15ull;
+
+/// splitmix64's finaliser alone (Stafford's "Mix13"): bijective, for callers that form their own state.
+constexpr std::uint64_t splitmix64_finalize(std::uint64_t x) {
   x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
   x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
   return x ^ (x >> 31);
 }
+
+/// splitmix64's output function (Steele, Lea & Flood 2014): a bijective, well-mixed 64-bit hash.
+/// mix64(0) is splitmix64's first output for seed 0.
+constexpr std::uint64_t mix64(std::uint64_t x) { return splitmix64_finalize(x + kSplitmixGamma); }
+
+/// The top 53 bits of a hash as a double uniform in [0, 1) (every value exact).
+constexpr double unit_double(std::uint64_t h) { return double(h >> 11) * 0x1.0p-53; }
 
 /// 128-bit digest: {hi, lo}.
 using Hash128 = std::array<std::uint64_t, 2>;

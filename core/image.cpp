@@ -69,16 +69,6 @@ RawImage read_raw(const std::string& path) {
 
 }  // namespace
 
-float linear_to_srgb(float linear) {
-  const float v = clamp01(linear);
-  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
-}
-
-float srgb_to_linear(float encoded) {
-  const float v = clamp01(encoded);
-  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
-}
-
 void write_image(const std::string& path, const ImageRGBA& image) {
   if (format_for(path) == Format::Exr) {
     write_pixels(path, image.width, image.height, 4, OIIO::TypeDesc::FLOAT, image.pixels.data());

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/colour.h"  // the sRGB curve of PNG files
 #include "core/errors.h"
 
 namespace raysift {
@@ -40,10 +41,6 @@ struct ChannelImage {
   std::vector<std::string> channel_names;
   std::vector<float> data;  ///< width*height*channel_names.size(), interleaved
 };
-
-/// sRGB transfer functions on [0,1] (values outside are clamped).
-float linear_to_srgb(float linear);
-float srgb_to_linear(float encoded);
 
 /// Writes by extension: .png (8-bit, sRGB-encoded RGB, linear alpha) or .exr (float, linear).
 /// Written atomically. \throw IoError for an unknown extension or a write failure.

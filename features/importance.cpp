@@ -1,13 +1,10 @@
 #include "features/importance.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/blocked_range2d.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <string>
 
+#include "core/bilinear.h"
 #include "core/errors.h"
 #include "core/parallel.h"
 #include "core/timer.h"
@@ -36,19 +33,6 @@ void validate(const ImportanceOptions& o, const BackgroundGeometry& bg) {
                          " must be in [0, 1], got " + std::to_string(o.priority[std::size_t(c)]));
   if (bg.bbox_ws && (bg.bbox_ws->is_empty() || !is_finite(bg.bbox_ws->min) || !is_finite(bg.bbox_ws->max)))
     throw InvalidInput("importance: the background bounding box is empty or not finite");
-}
-
-template <typename F>
-void for_pixels(int width, int height, bool threaded, const F& f) {
-  if (threaded) {
-    tbb::parallel_for(tbb::blocked_range2d<int>(0, height, 16, 0, width, 64), [&](const tbb::blocked_range2d<int>& r) {
-      for (int y = r.rows().begin(); y != r.rows().end(); ++y)
-        for (int x = r.cols().begin(); x != r.cols().end(); ++x) f(x, y);
-    });
-  } else {
-    for (int y = 0; y < height; ++y)
-      for (int x = 0; x < width; ++x) f(x, y);
-  }
 }
 
 /// Slab test: does the ray hit the box at some t >= 0 (a camera inside the box always hits)? The direction
@@ -94,18 +78,18 @@ Image<std::uint8_t> coverage(const Camera& camera, const BackgroundGeometry& bg,
   }
   if (mesh_frame_depth) {
     const ImageF& d = mesh_frame_depth->depth;
-    for_pixels(w, h, threaded, [&](int x, int y) {
+    parallel_pixels(w, h, [&](int x, int y) {
       const int fx0 = x * d.width / w, fx1 = std::max(fx0 + 1, (x + 1) * d.width / w);
       const int fy0 = y * d.height / h, fy1 = std::max(fy0 + 1, (y + 1) * d.height / h);
       for (int fy = fy0; fy < std::min(fy1, d.height); ++fy)
         for (int fx = fx0; fx < std::min(fx1, d.width); ++fx)
           if (d(fx, fy) != std::numeric_limits<float>::infinity()) hit(x, y) = 1;
-    });
+    }, threaded);
   } else if (bg.mesh) {
     const DepthBuffer db = rasterize_depth(*bg.mesh, camera, {threaded});
-    for_pixels(w, h, threaded, [&](int x, int y) {
+    parallel_pixels(w, h, [&](int x, int y) {
       if (db.face(x, y) != kNoFace) hit(x, y) = 1;
-    });
+    }, threaded);
   }
   return hit;
 }
@@ -145,12 +129,12 @@ ImportanceBuffer rasterize(const FeatureLines& visible, const Camera& frame, con
                                          [&](int x, int y, double, const detail::Segment2&) { seeds(x, y) = 1; });
     const ImageF d2 = detail::squared_distance_transform(seeds, 0.5 + falloff, o.threaded);
     const float reach2 = float((0.5 + falloff) * (0.5 + falloff));
-    for_pixels(w, h, o.threaded, [&](int x, int y) {
+    parallel_pixels(w, h, [&](int x, int y) {
       if (d2(x, y) >= reach2) return;  // beyond the fall-off: contributes 0
       const double u = std::clamp((std::sqrt(double(d2(x, y))) - 0.5) / falloff, 0.0, 1.0);
       float& cur = out.values(x, y);
       cur = std::max(cur, float(level * (1.0 - u * u * (3.0 - 2.0 * u))));
-    });
+    }, o.threaded);
   }
 
   if (bg.bbox_ws || bg.mesh) {
@@ -158,13 +142,13 @@ ImportanceBuffer rasterize(const FeatureLines& visible, const Camera& frame, con
     // Conservative: background only if no neighbouring buffer pixel sees the geometry, so that upsampling
     // to the frame never skips a frame pixel whose ray hits it.
     Image<std::uint8_t> row_hit(w, h, 0);  // separable 3x3 dilation: rows, then columns
-    for_pixels(w, h, o.threaded, [&](int x, int y) {
+    parallel_pixels(w, h, [&](int x, int y) {
       row_hit(x, y) = hit(x, y) | (x > 0 ? hit(x - 1, y) : 0) | (x + 1 < w ? hit(x + 1, y) : 0);
-    });
-    for_pixels(w, h, o.threaded, [&](int x, int y) {
+    }, o.threaded);
+    parallel_pixels(w, h, [&](int x, int y) {
       if (!(row_hit(x, y) | (y > 0 ? row_hit(x, y - 1) : 0) | (y + 1 < h ? row_hit(x, y + 1) : 0)))
         out.values(x, y) = o.background_value;
-    });
+    }, o.threaded);
   }
   return out;
 }
@@ -195,37 +179,18 @@ ImageF upsample_importance(const ImportanceBuffer& buffer, bool threaded) {
   const ImageF& v = buffer.values;
   const int w = buffer.frame_width, h = buffer.frame_height;
   ImageF out(w, h, 0.0f);
-  // Per frame column: the two buffer columns around its centre and the weight of the right one (the
-  // same clamped coordinates as sample_importance).
-  std::vector<int> x0(std::size_t(w), 0), x1(std::size_t(w), 0);
-  std::vector<float> tx(std::size_t(w), 0.0f);
-  for (int x = 0; x < w; ++x) {
-    const double fx = (x + 0.5) * v.width / w - 0.5;
-    const int i = int(std::floor(fx));
-    x0[std::size_t(x)] = std::clamp(i, 0, v.width - 1);
-    x1[std::size_t(x)] = std::clamp(i + 1, 0, v.width - 1);
-    tx[std::size_t(x)] = float(fx - i);
-  }
+  // The same clamped coordinates as sample_importance.
+  const BilinearTaps tx = bilinear_taps(w, v.width), ty = bilinear_taps(h, v.height);
   std::vector<std::uint8_t> row_has_background(std::size_t(v.height), 0);
   for (int y = 0; y < v.height; ++y)
     for (int x = 0; x < v.width; ++x) row_has_background[std::size_t(y)] |= v(x, y) < 0 ? 1 : 0;
   parallel_rows(h, [&](int y) {
-    const double fy = (y + 0.5) * v.height / h - 0.5;
-    const int j = int(std::floor(fy));
-    const int y0 = std::clamp(j, 0, v.height - 1), y1 = std::clamp(j + 1, 0, v.height - 1);
-    if (row_has_background[std::size_t(y0)] || row_has_background[std::size_t(y1)]) {
+    const std::size_t j = std::size_t(y);
+    if (row_has_background[std::size_t(ty.lo[j])] || row_has_background[std::size_t(ty.hi[j])]) {
       for (int x = 0; x < w; ++x) out(x, y) = sample_importance(buffer, x, y);
       return;
     }
-    const float ty = float(fy - j);
-    const float* r0 = &v(0, y0);
-    const float* r1 = &v(0, y1);
-    float* o = &out(0, y);
-    for (int x = 0; x < w; ++x) {
-      const std::size_t i = std::size_t(x);
-      const float a = r0[x0[i]] + (r1[x0[i]] - r0[x0[i]]) * ty, b = r0[x1[i]] + (r1[x1[i]] - r0[x1[i]]) * ty;
-      o[x] = a + (b - a) * tx[i];
-    }
+    for (int x = 0; x < w; ++x) out(x, y) = bilinear_at(v, tx, ty, x, y);
   }, threaded);
   return out;
 }

@@ -1,31 +1,20 @@
 #include "features/raster.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 #include <vector>
 
 #include "core/errors.h"
+#include "core/tolerances.h"
+#include "mesh/triangle_raster.h"
+#include "core/parallel.h"
 
 namespace raysift::features {
 namespace {
 
 constexpr int kBandRows = 16;
-
-/// floor and ceil for |x| < 2^31 without a libm call (std::floor is one without SSE4.1); callers clamp
-/// to the image first or pass screen coordinates of visible geometry.
-int floor_int(double x) {
-  const int i = int(x);
-  return i - (x < double(i) ? 1 : 0);
-}
-int ceil_int(double x) {
-  const int i = int(x);
-  return i + (x > double(i) ? 1 : 0);
-}
-double clamp_px(double x) { return std::clamp(x, -1e9, 1e9); }  // keeps the int conversions defined
 
 /// Float, as the set-up rounds corners to float anyway (12 bytes: the per-vertex array stays in cache).
 /// inv_z < 0 marks a vertex behind the near plane.
@@ -33,100 +22,44 @@ struct ScreenPoint {
   float x, y, inv_z;
 };
 
-/// A triangle ready to draw: edge functions e_j = ea·x + eb·y + ec (barycentric coordinates) and the
-/// affine 1/z plane, computed once however many bands it spans.
+/// A triangle ready to draw (set up once however many bands it spans) and the pixel centres its bounds span.
 struct ScreenTri {
-  double ea[3], eb[3], ec[3];
-  double ia, ib, ic;
+  mesh::RasterTriangle tri;
   int r0, r1, c0, c1;  // rows and columns whose pixel centres the triangle's bounds span (inclusive)
   std::uint32_t face;
 };
 
-/// Screen set-up (in double from the float corners); false if the triangle covers no pixel centre's
-/// bounds or is degenerate.
+/// Screen set-up (in double from the float corners); false if the triangle's bounds contain no pixel centre or
+/// it is degenerate.
 bool set_up(const ScreenPoint* p0, const ScreenPoint* p1, const ScreenPoint* p2, std::uint32_t face, int width,
             int height, ScreenTri& st) {
-  const ScreenPoint* corner[3] = {p0, p1, p2};
-  double x[3], y[3], iz[3];
-  for (int j = 0; j < 3; ++j) {
-    x[j] = corner[j]->x;
-    y[j] = corner[j]->y;
-    iz[j] = corner[j]->inv_z;
-  }
-  // Pixel centres (i + 0.5) inside the bounds; triangles that cover none are dropped here.
-  const double x0 = std::min({x[0], x[1], x[2]}), x1 = std::max({x[0], x[1], x[2]});
-  const double y0 = std::min({y[0], y[1], y[2]}), y1 = std::max({y[0], y[1], y[2]});
-  st.c0 = std::max(0, ceil_int(clamp_px(x0 - 0.5)));
-  st.c1 = std::min(width - 1, floor_int(clamp_px(x1 - 0.5)));
-  st.r0 = std::max(0, ceil_int(clamp_px(y0 - 0.5)));
-  st.r1 = std::min(height - 1, floor_int(clamp_px(y1 - 0.5)));
-  if (st.c0 > st.c1 || st.r0 > st.r1) return false;
-  const double area = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
-  if (!(std::abs(area) > 1e-12)) return false;
-  // Edge function of the edge opposite corner j, scaled by 1/area so that it is the barycentric
-  // coordinate.
-  for (int j = 0; j < 3; ++j) {
-    const int a = (j + 1) % 3, c = (j + 2) % 3;
-    st.ea[j] = -(y[c] - y[a]) / area;
-    st.eb[j] = (x[c] - x[a]) / area;
-    st.ec[j] = -(st.ea[j] * x[a] + st.eb[j] * y[a]);
-  }
-  // 1/z is affine on screen too: iz(x, y) = ia·x + ib·y + ic.
-  st.ia = st.ea[0] * iz[0] + st.ea[1] * iz[1] + st.ea[2] * iz[2];
-  st.ib = st.eb[0] * iz[0] + st.eb[1] * iz[1] + st.eb[2] * iz[2];
-  st.ic = st.ec[0] * iz[0] + st.ec[1] * iz[1] + st.ec[2] * iz[2];
+  const double x[3] = {p0->x, p1->x, p2->x}, y[3] = {p0->y, p1->y, p2->y}, iz[3] = {p0->inv_z, p1->inv_z, p2->inv_z};
+  if (!mesh::pixel_centre_range(std::min({x[0], x[1], x[2]}), std::max({x[0], x[1], x[2]}), width, st.c0, st.c1) ||
+      !mesh::pixel_centre_range(std::min({y[0], y[1], y[2]}), std::max({y[0], y[1], y[2]}), height, st.r0, st.r1))
+    return false;
   st.face = face;
-  return true;
+  return mesh::set_up_triangle(x, y, iz, st.tri);
 }
 
 /// One band of rows being drawn: the nearest surface as 1/z (double, 0 = empty), so a fragment costs no
-/// division; converted to depth once per pixel at the end.
+/// division; converted to depth once per pixel at the end. Ties in 1/z go to the lower face index, so the
+/// order in which the band visits its triangles does not change the image.
 struct Band {
   int r0, width;
   std::vector<double> inv_z;
   std::vector<std::uint32_t> face;
-  void test(const ScreenTri& st, int col, int row, double px, double py) {
-    const double iz = st.ia * px + st.ib * py + st.ic;
-    const std::size_t i = std::size_t(row - r0) * std::size_t(width) + std::size_t(col);
-    if (iz > inv_z[i] || (iz == inv_z[i] && st.face < face[i])) {
-      inv_z[i] = iz;
-      face[i] = st.face;
-    }
+
+  /// Depth-tests the triangle's pixels in rows [r0, r1] (mesh/triangle_raster.h coverage).
+  void draw(const ScreenTri& st, int rows_first, int rows_last) {
+    mesh::draw_triangle(st.tri, st.c0, st.c1, rows_first, rows_last, [&](int col, int row, double iz) {
+      const std::size_t i = std::size_t(row - r0) * std::size_t(width) + std::size_t(col);
+      if (iz > inv_z[i] || (iz == inv_z[i] && st.face < face[i])) {
+        inv_z[i] = iz;
+        face[i] = st.face;
+      }
+    });
   }
 };
-
-/// Depth-tests the triangle's pixels in rows [r0, r1].
-void draw(const ScreenTri& st, int r0, int r1, Band& band) {
-  // At importance resolution most triangles span a few pixels: testing each centre against the edges
-  // needs no division, unlike the per-row span below.
-  if ((st.c1 - st.c0 + 1) * (r1 - r0 + 1) <= 8) {
-    for (int r = r0; r <= r1; ++r) {
-      const double py = r + 0.5;
-      for (int col = st.c0; col <= st.c1; ++col) {
-        const double px = col + 0.5;
-        if (st.ea[0] * px + st.eb[0] * py + st.ec[0] >= 0 && st.ea[1] * px + st.eb[1] * py + st.ec[1] >= 0 &&
-            st.ea[2] * px + st.eb[2] * py + st.ec[2] >= 0)
-          band.test(st, col, r, px, py);
-      }
-    }
-    return;
-  }
-  for (int r = r0; r <= r1; ++r) {
-    const double py = r + 0.5;
-    // The covered columns of this row form one span: each edge bounds px = col + 0.5 from one side.
-    int lo = st.c0, hi = st.c1;
-    for (int j = 0; j < 3 && lo <= hi; ++j) {
-      const double k = st.eb[j] * py + st.ec[j];  // b_j = ea[j]·px + k >= 0
-      if (st.ea[j] > 0)
-        lo = std::max(lo, ceil_int(clamp_px(-k / st.ea[j] - 0.5)));
-      else if (st.ea[j] < 0)
-        hi = std::min(hi, floor_int(clamp_px(-k / st.ea[j] - 0.5)));
-      else if (k < 0)
-        hi = lo - 1;
-    }
-    for (int col = lo; col <= hi; ++col) band.test(st, col, r, col + 0.5, py);
-  }
-}
 
 /// The triangles of one chunk of faces, copied into each band of kBandRows rows they touch (in face
 /// order), so that drawing a band streams through contiguous memory.
@@ -138,17 +71,35 @@ struct ViewPoint {
   double x, y, z;  // along right, image up, forward (z = view depth)
 };
 
-template <typename F>
-void for_chunks(std::size_t n, std::size_t chunk, bool threaded, const F& body) {
-  const std::size_t chunks = (n + chunk - 1) / chunk;
-  auto run = [&](std::size_t c) { body(c, c * chunk, std::min(n, (c + 1) * chunk)); };
-  if (threaded) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t c = r.begin(); c != r.end(); ++c) run(c);
-    });
-  } else {
-    for (std::size_t c = 0; c < chunks; ++c) run(c);
+/// The bounding box of the used vertices. \throw InvalidInput for an index out of range or a NaN/Inf vertex.
+Bbox3d checked_bounds(const TriMesh& mesh) {
+  Bbox3d box;
+  for (std::size_t f = 0; f < mesh.triangle_count(); ++f)
+    for (std::uint32_t v : mesh.triangles[f]) {
+      if (v >= mesh.vertex_count())
+        throw InvalidInput("rasterize: triangle " + std::to_string(f) + " references vertex " + std::to_string(v) +
+                           " of " + std::to_string(mesh.vertex_count()));
+      if (!is_finite(mesh.positions[v]))
+        throw InvalidInput("rasterize: vertex " + std::to_string(v) + " has a NaN or infinite coordinate");
+      box.expand(Vec3d(mesh.positions[v]));
+    }
+  return box;
+}
+
+/// The part of triangle `tri` at or beyond view depth `near`, as a polygon of up to 4 corners in order;
+/// returns the corner count (0 when the triangle lies wholly in front of the near plane).
+int clip_to_near(const std::array<ViewPoint, 3>& tri, double near, ViewPoint (&poly)[4]) {
+  int n = 0;
+  for (int k = 0; k < 3; ++k) {
+    const ViewPoint& p = tri[std::size_t(k)];
+    const ViewPoint& q = tri[std::size_t((k + 1) % 3)];
+    if (p.z >= near) poly[n++] = p;
+    if ((p.z >= near) != (q.z >= near)) {
+      const double s = (near - p.z) / (q.z - p.z);
+      poly[n++] = {p.x + s * (q.x - p.x), p.y + s * (q.y - p.y), near};
+    }
   }
+  return n;
 }
 
 
@@ -167,19 +118,9 @@ DepthBuffer rasterize_depth(const TriMesh& mesh, const Camera& camera, const Ras
   const int width = camera.width(), height = camera.height();
   DepthBuffer out{camera.spec(), ImageF(width, height, std::numeric_limits<float>::infinity()),
                   ImageU32(width, height, kNoFace)};
-  Bbox3d box;
-  for (std::size_t f = 0; f < mesh.triangle_count(); ++f)
-    for (std::uint32_t v : mesh.triangles[f]) {
-      if (v >= mesh.vertex_count())
-        throw InvalidInput("rasterize: triangle " + std::to_string(f) + " references vertex " + std::to_string(v) +
-                           " of " + std::to_string(mesh.vertex_count()));
-      if (!is_finite(mesh.positions[v]))
-        throw InvalidInput("rasterize: vertex " + std::to_string(v) + " has a NaN or infinite coordinate");
-      box.expand(Vec3d(mesh.positions[v]));
-    }
+  const Bbox3d box = checked_bounds(mesh);
   if (mesh.empty()) return out;
-  // Relative to the scene size: closer than this to the eye plane a vertex is clipped away.
-  const double near = std::max(1e-6 * box.diagonal(), 1e-30);
+  const double near = std::max(tol::kNearPlaneRelative * box.diagonal(), 1e-30);
   const double tan_y = std::tan(camera.spec().fov_y_deg * M_PI / 360.0);
   const double tan_x = tan_y * double(width) / double(height);
 
@@ -190,13 +131,13 @@ DepthBuffer rasterize_depth(const TriMesh& mesh, const Camera& camera, const Ras
     return ScreenPoint{float((p.x / p.z / tan_x + 1.0) * 0.5 * width), float((1.0 - p.y / p.z / tan_y) * 0.5 * height),
                        float(1.0 / p.z)};
   };
-  for_chunks(view.size(), 8192, options.threaded, [&](std::size_t, std::size_t b, std::size_t e) {
+  parallel_chunks(view.size(), 8192, [&](std::size_t, std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       const Vec3d d = Vec3d(mesh.positions[i]) - camera.eye();
       view[i] = {dot(d, camera.right()), dot(d, camera.image_up()), dot(d, camera.forward())};
       screen[i] = view[i].z >= near ? to_screen(view[i]) : ScreenPoint{0, 0, -1};
     }
-  });
+  }, options.threaded);
 
   // Per chunk of faces (in parallel): clip at the near plane, set up the edge and depth planes once, and
   // bin the triangles into bands of rows. The depth test breaks ties by face index, so the order in
@@ -204,7 +145,7 @@ DepthBuffer rasterize_depth(const TriMesh& mesh, const Camera& camera, const Ras
   constexpr std::size_t kChunk = 8192;
   const int bands = (height + kBandRows - 1) / kBandRows;
   std::vector<Chunk> chunks((mesh.triangle_count() + kChunk - 1) / kChunk);
-  for_chunks(mesh.triangle_count(), kChunk, options.threaded, [&](std::size_t c, std::size_t b, std::size_t e) {
+  parallel_chunks(mesh.triangle_count(), kChunk, [&](std::size_t c, std::size_t b, std::size_t e) {
     std::vector<std::vector<ScreenTri>>& by_band = chunks[c].bands;
     by_band.resize(std::size_t(bands));
     auto add = [&](const ScreenPoint* p0, const ScreenPoint* p1, const ScreenPoint* p2, std::uint32_t face) {
@@ -220,35 +161,26 @@ DepthBuffer rasterize_depth(const TriMesh& mesh, const Camera& camera, const Ras
         continue;
       }
       ViewPoint poly[4];
-      int n = 0;
-      for (int k = 0; k < 3 && in_front > 0; ++k) {
-        const ViewPoint& p = view[t[k]];
-        const ViewPoint& q = view[t[(k + 1) % 3]];
-        if (p.z >= near) poly[n++] = p;
-        if ((p.z >= near) != (q.z >= near)) {
-          const double s = (near - p.z) / (q.z - p.z);
-          poly[n++] = {p.x + s * (q.x - p.x), p.y + s * (q.y - p.y), near};
-        }
-      }
+      const int n = in_front > 0 ? clip_to_near({view[t[0]], view[t[1]], view[t[2]]}, near, poly) : 0;
       ScreenPoint sp[4];
       for (int k = 0; k < n; ++k) sp[k] = to_screen(poly[k]);
       for (int k = 1; k + 1 < n; ++k) add(&sp[0], &sp[k], &sp[k + 1], std::uint32_t(f));
     }
-  });
+  }, options.threaded);
 
-  for_chunks(std::size_t(bands), 1, options.threaded, [&](std::size_t b, std::size_t, std::size_t) {
+  parallel_chunks(std::size_t(bands), 1, [&](std::size_t b, std::size_t, std::size_t) {
     const int band_r0 = int(b) * kBandRows, band_r1 = std::min(height - 1, band_r0 + kBandRows - 1);
     const std::size_t n = std::size_t(band_r1 - band_r0 + 1) * std::size_t(width);
     Band band{band_r0, width, std::vector<double>(n, 0.0), std::vector<std::uint32_t>(n, kNoFace)};
     for (const Chunk& chunk : chunks)
-      for (const ScreenTri& st : chunk.bands[b]) draw(st, std::max(st.r0, band_r0), std::min(st.r1, band_r1), band);
+      for (const ScreenTri& st : chunk.bands[b]) band.draw(st, std::max(st.r0, band_r0), std::min(st.r1, band_r1));
     // Rounding is monotone, so float(1 / max 1/z) is the least float depth of the fragments.
     for (std::size_t i = 0; i < n; ++i) {
       if (band.face[i] == kNoFace) continue;
       out.depth.pixels[std::size_t(band_r0) * std::size_t(width) + i] = float(1.0 / band.inv_z[i]);
       out.face.pixels[std::size_t(band_r0) * std::size_t(width) + i] = band.face[i];
     }
-  });
+  }, options.threaded);
   return out;
 }
 

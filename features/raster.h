@@ -2,7 +2,8 @@
 /// \file Z-buffer rasterisation of a triangle mesh: the opaque base mesh that hides occluded lines (RP
 /// paper §4.1), the object coverage for exterior silhouettes and background, and the face ids for the
 /// shaded picture. Key decision: one CPU rasteriser instead of ray casting, because one pass gives all
-/// three; triangles are clipped at a near plane so a camera inside the mesh is handled.
+/// three; triangles are clipped at a near plane so a camera inside the mesh is handled. Coverage and depth
+/// interpolation are mesh/triangle_raster.h's (the rasteriser nrr's shadow maps use too).
 #include <cstdint>
 #include <limits>
 

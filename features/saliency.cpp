@@ -1,16 +1,13 @@
 #include "features/saliency.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <sstream>
 #include <vector>
 
+#include "core/colour.h"
 #include "core/errors.h"
 #include "core/parallel.h"
 
@@ -36,17 +33,6 @@ constexpr int kGaborRadius = 4;           // 9x9 kernel [choice]
 constexpr double kGaborWavelengthPx = 4;  // [choice]
 constexpr double kGaborSigmaPx = 2;       // [choice]
 constexpr int kOrientations = 4;          // 0, 45, 90, 135 degrees
-
-template <typename F>
-void for_items(int count, bool threaded, const F& item) {
-  if (!threaded) {
-    for (int i = 0; i < count; ++i) item(i);
-    return;
-  }
-  tbb::parallel_for(tbb::blocked_range<int>(0, count, 1), [&](const tbb::blocked_range<int>& r) {
-    for (int i = r.begin(); i < r.end(); ++i) item(i);
-  });
-}
 
 void validate(const ImageRGBA& image, const SaliencyOptions& options) {
   std::ostringstream why;
@@ -147,41 +133,13 @@ std::array<Plane, 3> downscale_rgb(const ImageRGBA& image, int w, int h, bool th
   return out;
 }
 
-/// Cube root of t > 0 for CIELAB: a bit-trick estimate (within 3.3 %) refined by two Halley steps
-/// (cubic convergence, relative error below 1e-12); std::cbrt was the most expensive call of the map.
-double cube_root(double t) {
-  std::uint64_t bits = 0;
-  std::memcpy(&bits, &t, sizeof bits);
-  bits = bits / 3 + 0x2A9F7893782DA1CEull;
-  double y = 0;
-  std::memcpy(&y, &bits, sizeof y);
-  for (int i = 0; i < 2; ++i) {
-    const double y3 = y * y * y;
-    y *= (y3 + 2.0 * t) / (2.0 * y3 + t);
-  }
-  return y;
-}
-
 /// Linear sRGB primaries -> CIELAB (D65 white), in place: planes become L*, a*, b*.
 void rgb_to_lab(std::array<Plane, 3>& planes, bool threaded) {
-  constexpr double kXn = 0.95047, kYn = 1.0, kZn = 1.08883;
-  constexpr double kDelta = 6.0 / 29.0;
-  const auto f = [](double t) {
-    return t > kDelta * kDelta * kDelta ? cube_root(t) : t / (3.0 * kDelta * kDelta) + 4.0 / 29.0;
-  };
   const int w = planes[0].width;
   parallel_rows(planes[0].height, [&](int y) {
     for (int x = 0; x < w; ++x) {
-      // Negative linear values (out-of-gamut renders) have no colorimetric meaning: clamp to black.
-      const double r = std::max(0.0f, planes[0](x, y));
-      const double g = std::max(0.0f, planes[1](x, y));
-      const double b = std::max(0.0f, planes[2](x, y));
-      const double fx = f((0.4124564 * r + 0.3575761 * g + 0.1804375 * b) / kXn);
-      const double fy = f((0.2126729 * r + 0.7151522 * g + 0.0721750 * b) / kYn);
-      const double fz = f((0.0193339 * r + 0.1191920 * g + 0.9503041 * b) / kZn);
-      planes[0](x, y) = float(116.0 * fy - 16.0);
-      planes[1](x, y) = float(500.0 * (fx - fy));
-      planes[2](x, y) = float(200.0 * (fy - fz));
+      const Colour3 lab = linear_srgb_to_cielab({planes[0](x, y), planes[1](x, y), planes[2](x, y)});
+      for (int c = 0; c < 3; ++c) planes[std::size_t(c)](x, y) = float(lab[std::size_t(c)]);
     }
   }, threaded);
 }
@@ -360,6 +318,43 @@ struct FeatureSpec {
   int surround;
 };
 
+/// pyramids[channel][level]; channels 0..2 = L*, a*, b* (consumed from `lab`), then one per Gabor orientation.
+std::vector<std::vector<Plane>> build_pyramids(std::array<Plane, 3>& lab, bool use_orientation, bool threaded) {
+  const int n_channels = use_orientation ? 3 + kOrientations : 3;
+  std::vector<std::vector<Plane>> pyramids{std::size_t(n_channels)};
+  for (int c = 0; c < 3; ++c) {
+    auto& levels = pyramids[std::size_t(c)];
+    levels.push_back(std::move(lab[std::size_t(c)]));
+    while (int(levels.size()) < kMaxLevels && std::min(levels.back().width, levels.back().height) > 1)
+      levels.push_back(reduce(levels.back(), threaded));
+  }
+  const int n_levels = int(pyramids[0].size());
+  if (use_orientation) {
+    // Level 0 takes part in no centre-surround pair, so its Gabor response is never needed.
+    for (int o = 0; o < kOrientations; ++o) {
+      const Kernel kernel = gabor_kernel(M_PI * o / kOrientations);
+      auto& levels = pyramids[std::size_t(3 + o)];
+      levels.resize(std::size_t(n_levels));
+      for (int l = 1; l < n_levels; ++l) levels[std::size_t(l)] = gabor_energy(pyramids[0][std::size_t(l)], kernel, threaded);
+    }
+  }
+  return pyramids;
+}
+
+/// Every (channel, centre, surround) feature map, with the surround capped at the coarsest level.
+std::vector<FeatureSpec> feature_specs(int n_channels, int n_levels) {
+  std::vector<std::pair<int, int>> pairs;
+  for (int c : kCentreLevels)
+    for (int d : kSurroundDeltas) {
+      const int s = std::min(c + d, n_levels - 1);
+      if (s > c && std::find(pairs.begin(), pairs.end(), std::make_pair(c, s)) == pairs.end()) pairs.emplace_back(c, s);
+    }
+  std::vector<FeatureSpec> specs;
+  for (int ch = 0; ch < n_channels; ++ch)
+    for (const auto& [c, s] : pairs) specs.push_back({ch, c, s});
+  return specs;
+}
+
 }  // namespace
 
 int saliency_map_side(int image_side, double scale) {
@@ -376,41 +371,14 @@ ImageF compute_saliency(const ImageRGBA& image, const SaliencyOptions& options) 
   require_finite(lab, image);
   rgb_to_lab(lab, threaded);
 
-  // pyramids[channel][level]; channels 0..2 = L*, a*, b*, then one per Gabor orientation.
-  const int n_channels = options.use_orientation ? 3 + kOrientations : 3;
-  std::vector<std::vector<Plane>> pyramids{std::size_t(n_channels)};
-  for (int c = 0; c < 3; ++c) {
-    auto& levels = pyramids[std::size_t(c)];
-    levels.push_back(std::move(lab[std::size_t(c)]));
-    while (int(levels.size()) < kMaxLevels && std::min(levels.back().width, levels.back().height) > 1)
-      levels.push_back(reduce(levels.back(), threaded));
-  }
-  const int n_levels = int(pyramids[0].size());
-  if (options.use_orientation) {
-    // Level 0 takes part in no centre-surround pair, so its Gabor response is never needed.
-    for (int o = 0; o < kOrientations; ++o) {
-      const Kernel kernel = gabor_kernel(M_PI * o / kOrientations);
-      auto& levels = pyramids[std::size_t(3 + o)];
-      levels.resize(std::size_t(n_levels));
-      for (int l = 1; l < n_levels; ++l) levels[std::size_t(l)] = gabor_energy(pyramids[0][std::size_t(l)], kernel, threaded);
-    }
-  }
-
-  std::vector<std::pair<int, int>> pairs;
-  for (int c : kCentreLevels)
-    for (int d : kSurroundDeltas) {
-      const int s = std::min(c + d, n_levels - 1);
-      if (s > c && std::find(pairs.begin(), pairs.end(), std::make_pair(c, s)) == pairs.end()) pairs.emplace_back(c, s);
-    }
-  std::vector<FeatureSpec> specs;
-  for (int ch = 0; ch < n_channels; ++ch)
-    for (const auto& [c, s] : pairs) specs.push_back({ch, c, s});
+  const std::vector<std::vector<Plane>> pyramids = build_pyramids(lab, options.use_orientation, threaded);
+  const std::vector<FeatureSpec> specs = feature_specs(int(pyramids.size()), int(pyramids[0].size()));
 
   // Each feature map is an independent task writing only its own slot; the sums below run in a
   // fixed order, so the result does not depend on scheduling.
   const Plane& base = pyramids[0][kConspicuityLevel];
   std::vector<Plane> features(specs.size());
-  for_items(int(specs.size()), threaded, [&](int i) {
+  parallel_for_each(int(specs.size()), [&](int i) {
     const FeatureSpec& f = specs[std::size_t(i)];
     const Plane& centre = pyramids[std::size_t(f.channel)][std::size_t(f.centre)];
     const Plane& surround = pyramids[std::size_t(f.channel)][std::size_t(f.surround)];
@@ -419,7 +387,7 @@ ImageF compute_saliency(const ImageRGBA& image, const SaliencyOptions& options) 
     normalize_map(diff, kContrastFloorLab);
     const int up = 1 << (f.centre - kConspicuityLevel);
     features[std::size_t(i)] = up == 1 ? std::move(diff) : expand_to(diff, base.width, base.height, up);
-  });
+  }, threaded);
 
   const auto sum_of = [&](int first_channel, int last_channel) {
     Plane acc(base.width, base.height, 0.f);

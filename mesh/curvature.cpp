@@ -1,13 +1,12 @@
 #include "mesh/curvature.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <string>
 
 #include "core/errors.h"
+#include "core/tolerances.h"
+#include "core/parallel.h"
 #include "core/span.h"
 
 namespace raysift::mesh {
@@ -15,17 +14,6 @@ namespace {
 
 using Tensor = std::array<double, 3>;   // (e, f, g): second fundamental form in some (u, v) frame
 using DTensor = std::array<double, 4>;  // (C111, C112, C122, C222)
-
-template <typename F>
-void for_range(std::size_t n, bool threaded, const F& body) {
-  if (threaded) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
-    });
-  } else {
-    for (std::size_t i = 0; i < n; ++i) body(i);
-  }
-}
 
 /// Solves the symmetric system A x = b by LDLᵀ (A is a least-squares normal matrix). Returns false when a
 /// pivot is not clearly positive (relative to the largest diagonal entry): the face is then skipped, as
@@ -241,44 +229,60 @@ double signed_volume6(const TriMesh& mesh, const Vec3d& origin) {
   return sum;
 }
 
-MeshCurvature compute_oriented(const TriMesh& mesh, const CurvatureOptions& options) {
-  const std::size_t nv = mesh.vertex_count(), nf = mesh.triangle_count();
-  const bool threaded = options.threaded;
-  MeshCurvature out;
+constexpr std::size_t kGrain = 1024;  // vertices or faces per task: each item is a few hundred flops
 
+/// What the stages of compute_oriented share: the mesh, its face frames and the per-vertex frames in double.
+struct CurvatureWork {
+  const TriMesh& mesh;
+  bool threaded;
+  VertexFaces vf;
+  std::vector<FaceFrame> faces;
+  std::vector<Vec3d> normal, u, v;  ///< vertex normal and the (u, v) frame of the second fundamental form
+  std::vector<Vec3d> d1, d2;        ///< principal directions
+
+  template <typename F>
+  void for_faces(const F& f) const { parallel_for_each(mesh.triangle_count(), f, threaded, kGrain); }
+  template <typename F>
+  void for_vertices(const F& f) const { parallel_for_each(mesh.vertex_count(), f, threaded, kGrain); }
+};
+
+/// Edges, tangent frame and corner areas per face; faces below rounding-noise area or with a repeated vertex
+/// stay degenerate.
+void compute_face_frames(CurvatureWork& w, MeshCurvature& out) {
   Bbox3d box;
-  for (const Vec3f& p : mesh.positions) box.expand(Vec3d(p));
-  // Relative to the squared bbox diagonal: below this a face's area is rounding noise.
-  const double min_area = 1e-14 * box.diagonal() * box.diagonal();
-
-  std::vector<FaceFrame> faces(nf);
-  for_range(nf, threaded, [&](std::size_t f) {
-    const auto p = face_points(mesh, f);
-    FaceFrame& ff = faces[f];
+  for (const Vec3f& p : w.mesh.positions) box.expand(Vec3d(p));
+  const double min_area = tol::kDegenerateAreaRelative * box.diagonal() * box.diagonal();
+  w.faces.assign(w.mesh.triangle_count(), FaceFrame{});
+  w.for_faces([&](std::size_t f) {
+    const auto p = face_points(w.mesh, f);
+    FaceFrame& ff = w.faces[f];
     ff.edge = {p[2] - p[1], p[0] - p[2], p[1] - p[0]};
     const Vec3d n = cross(ff.edge[0], ff.edge[1]);
     const double area = 0.5 * length(n);
-    const auto& t = mesh.triangles[f];
+    const auto& t = w.mesh.triangles[f];
     if (!(area > min_area) || t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) return;
     ff.is_degenerate = false;
     ff.t = normalize(ff.edge[0]);
     ff.b = normalize(cross(n, ff.t));
     ff.corner_area = corner_areas(ff.edge, area);
   });
-  for (const FaceFrame& ff : faces) out.degenerate_faces += ff.is_degenerate ? 1 : 0;
+  for (const FaceFrame& ff : w.faces) out.degenerate_faces += ff.is_degenerate ? 1 : 0;
+}
 
-  const VertexFaces vf = build_vertex_faces(mesh);
+/// Vertex kind, normal (Max 1999 weights), point area and validity; counts the kinds into `out`.
+void compute_vertex_normals(CurvatureWork& w, MeshCurvature& out) {
+  const std::size_t nv = w.mesh.vertex_count();
   out.normals.assign(nv, Vec3f{});
   out.point_areas.assign(nv, 0.0f);
   out.is_valid.assign(nv, 0);
+  w.normal.assign(nv, Vec3d{});
   std::vector<VertexKind> kind(nv);
-  std::vector<Vec3d> normal(nv), u(nv), v(nv);
-  for_range(nv, threaded, [&](std::size_t vi) {
-    kind[vi] = classify_vertex(mesh, vf.of(vi), faces);
+  w.for_vertices([&](std::size_t vi) {
+    kind[vi] = classify_vertex(w.mesh, w.vf.of(vi), w.faces);
     Vec3d n{};
     double area = 0;
-    for (std::uint32_t c : vf.of(vi)) {
-      const FaceFrame& ff = faces[c / 3];
+    for (std::uint32_t c : w.vf.of(vi)) {
+      const FaceFrame& ff = w.faces[c / 3];
       if (ff.is_degenerate) continue;
       const int j = int(c % 3);
       // Max (1999) weights: face normal over the squared lengths of the two edges at this corner.
@@ -287,79 +291,112 @@ MeshCurvature compute_oriented(const TriMesh& mesh, const CurvatureOptions& opti
       n += cross(ff.edge[0], ff.edge[1]) * (1.0 / (dot(ea, ea) * dot(eb, eb)));
       area += ff.corner_area[j];
     }
-    normal[vi] = normalize(n);
+    w.normal[vi] = normalize(n);
     out.point_areas[vi] = float(area);
     const bool is_manifold = kind[vi] == VertexKind::Interior || kind[vi] == VertexKind::Boundary;
-    out.is_valid[vi] = (is_manifold && length(normal[vi]) > 0) ? 1 : 0;
-    out.normals[vi] = out.is_valid[vi] ? Vec3f(normal[vi]) : Vec3f{};
+    out.is_valid[vi] = (is_manifold && length(w.normal[vi]) > 0) ? 1 : 0;
+    out.normals[vi] = out.is_valid[vi] ? Vec3f(w.normal[vi]) : Vec3f{};
   });
   for (std::size_t vi = 0; vi < nv; ++vi) {
     out.boundary_vertices += kind[vi] == VertexKind::Boundary ? 1 : 0;
     out.nonmanifold_vertices += kind[vi] == VertexKind::NonManifold ? 1 : 0;
     out.unreferenced_vertices += kind[vi] == VertexKind::Isolated ? 1 : 0;
   }
-  for_range(nf, threaded, [&](std::size_t f) {
-    const auto& t = mesh.triangles[f];
-    faces[f].is_fitted = !faces[f].is_degenerate && out.is_valid[t[0]] && out.is_valid[t[1]] && out.is_valid[t[2]];
-  });
+}
 
-  // Initial vertex frames: an incident edge made perpendicular to the normal (trimesh2).
-  for_range(nv, threaded, [&](std::size_t vi) {
-    for (std::uint32_t c : vf.of(vi)) {
-      if (!out.is_valid[vi] || faces[c / 3].is_degenerate) continue;
-      const Vec3d e = faces[c / 3].edge[(c % 3 + 2) % 3];  // from this corner to the next
-      u[vi] = normalize(cross(e, normal[vi]));
-      if (length(u[vi]) > 0) break;
+/// Faces whose three vertices are valid get fitted; initial vertex frames are an incident edge made
+/// perpendicular to the normal (trimesh2).
+void compute_initial_frames(CurvatureWork& w, const MeshCurvature& out) {
+  w.for_faces([&](std::size_t f) {
+    const auto& t = w.mesh.triangles[f];
+    w.faces[f].is_fitted = !w.faces[f].is_degenerate && out.is_valid[t[0]] && out.is_valid[t[1]] && out.is_valid[t[2]];
+  });
+  w.u.assign(w.mesh.vertex_count(), Vec3d{});
+  w.v.assign(w.mesh.vertex_count(), Vec3d{});
+  w.for_vertices([&](std::size_t vi) {
+    for (std::uint32_t c : w.vf.of(vi)) {
+      if (!out.is_valid[vi] || w.faces[c / 3].is_degenerate) continue;
+      const Vec3d e = w.faces[c / 3].edge[(c % 3 + 2) % 3];  // from this corner to the next
+      w.u[vi] = normalize(cross(e, w.normal[vi]));
+      if (length(w.u[vi]) > 0) break;
     }
-    v[vi] = cross(normal[vi], u[vi]);
+    w.v[vi] = cross(w.normal[vi], w.u[vi]);
   });
+}
 
-  // Second fundamental form per face from normal differences along the edges.
-  std::vector<Tensor> face_ii(nf);
-  for_range(nf, threaded, [&](std::size_t f) {
-    FaceFrame& ff = faces[f];
+/// Second fundamental form per face from normal differences along the edges (least squares); a face whose
+/// system is singular is no longer fitted.
+std::vector<Tensor> fit_face_second_forms(CurvatureWork& w) {
+  std::vector<Tensor> face_ii(w.mesh.triangle_count());
+  w.for_faces([&](std::size_t f) {
+    FaceFrame& ff = w.faces[f];
     if (!ff.is_fitted) return;
-    const auto& tri = mesh.triangles[f];
+    const auto& tri = w.mesh.triangles[f];
     double m[3] = {0, 0, 0};
-    double w[3][3] = {};
+    double a[3][3] = {};
     for (int j = 0; j < 3; ++j) {
       const double eu = dot(ff.edge[j], ff.t), ev = dot(ff.edge[j], ff.b);
-      w[0][0] += eu * eu;
-      w[0][1] += eu * ev;
-      w[2][2] += ev * ev;
-      const Vec3d dn = normal[tri[(j + 2) % 3]] - normal[tri[(j + 1) % 3]];
+      a[0][0] += eu * eu;
+      a[0][1] += eu * ev;
+      a[2][2] += ev * ev;
+      const Vec3d dn = w.normal[tri[(j + 2) % 3]] - w.normal[tri[(j + 1) % 3]];
       const double dnu = dot(dn, ff.t), dnv = dot(dn, ff.b);
       m[0] += dnu * eu;
       m[1] += dnu * ev + dnv * eu;
       m[2] += dnv * ev;
     }
-    w[1][1] = w[0][0] + w[2][2];
-    w[1][2] = w[0][1];
-    w[1][0] = w[0][1];
-    w[2][1] = w[1][2];
+    a[1][1] = a[0][0] + a[2][2];
+    a[1][2] = a[0][1];
+    a[1][0] = a[0][1];
+    a[2][1] = a[1][2];
     double x[3];
-    if (!solve_ldlt<3>(w, m, x)) {
+    if (!solve_ldlt<3>(a, m, x)) {
       ff.is_fitted = false;
       return;
     }
     face_ii[f] = {x[0], x[1], x[2]};
   });
+  return face_ii;
+}
 
-  // Gather into vertex frames with corner-area weights, then diagonalise (one Jacobi rotation).
+/// Principal curvatures and directions of the tensor k in the frame (ru, rv) by one Jacobi rotation; k1 is
+/// the one of larger magnitude.
+void diagonalise(const Tensor& k, const Vec3d& ru, const Vec3d& rv, double& k1, double& k2, Vec3d& d1) {
+  double c = 1, s = 0, tt = 0;
+  if (k[1] != 0) {
+    const double h = 0.5 * (k[2] - k[0]) / k[1];
+    tt = h < 0 ? 1 / (h - std::sqrt(1 + h * h)) : 1 / (h + std::sqrt(1 + h * h));
+    c = 1 / std::sqrt(1 + tt * tt);
+    s = tt * c;
+  }
+  k1 = k[0] - tt * k[1];
+  k2 = k[2] + tt * k[1];
+  if (std::abs(k1) >= std::abs(k2)) {
+    d1 = ru * c - rv * s;
+  } else {
+    std::swap(k1, k2);
+    d1 = ru * s + rv * c;
+  }
+}
+
+/// Face tensors gathered into the vertex frames with corner-area weights, then diagonalised.
+void compute_principal_curvatures(CurvatureWork& w, const std::vector<Tensor>& face_ii, MeshCurvature& out) {
+  const std::size_t nv = w.mesh.vertex_count();
   out.k1.assign(nv, 0.0f);
   out.k2.assign(nv, 0.0f);
   out.dir1.assign(nv, Vec3f{});
   out.dir2.assign(nv, Vec3f{});
-  std::vector<Vec3d> d1(nv), d2(nv);
-  for_range(nv, threaded, [&](std::size_t vi) {
+  w.d1.assign(nv, Vec3d{});
+  w.d2.assign(nv, Vec3d{});
+  w.for_vertices([&](std::size_t vi) {
     if (!out.is_valid[vi]) return;
     Tensor k{0, 0, 0};
     double weight = 0;
-    for (std::uint32_t c : vf.of(vi)) {
-      const FaceFrame& ff = faces[c / 3];
+    for (std::uint32_t c : w.vf.of(vi)) {
+      const FaceFrame& ff = w.faces[c / 3];
       if (!ff.is_fitted) continue;
       const double wt = ff.corner_area[c % 3];
-      const Tensor p = project_tensor(ff.t, ff.b, face_ii[c / 3], u[vi], v[vi]);
+      const Tensor p = project_tensor(ff.t, ff.b, face_ii[c / 3], w.u[vi], w.v[vi]);
       for (int i = 0; i < 3; ++i) k[i] += wt * p[i];
       weight += wt;
     }
@@ -368,89 +405,99 @@ MeshCurvature compute_oriented(const TriMesh& mesh, const CurvatureOptions& opti
     if (weight > 0)
       for (double& x : k) x /= weight;
     Vec3d ru, rv;
-    rotate_frame(u[vi], v[vi], normal[vi], ru, rv);
-    double c = 1, s = 0, tt = 0;
-    if (k[1] != 0) {
-      const double h = 0.5 * (k[2] - k[0]) / k[1];
-      tt = h < 0 ? 1 / (h - std::sqrt(1 + h * h)) : 1 / (h + std::sqrt(1 + h * h));
-      c = 1 / std::sqrt(1 + tt * tt);
-      s = tt * c;
-    }
-    double k1 = k[0] - tt * k[1], k2 = k[2] + tt * k[1];
-    if (std::abs(k1) >= std::abs(k2)) {
-      d1[vi] = ru * c - rv * s;
-    } else {
-      std::swap(k1, k2);
-      d1[vi] = ru * s + rv * c;
-    }
-    d2[vi] = cross(normal[vi], d1[vi]);
+    rotate_frame(w.u[vi], w.v[vi], w.normal[vi], ru, rv);
+    double k1, k2;
+    diagonalise(k, ru, rv, k1, k2, w.d1[vi]);
+    w.d2[vi] = cross(w.normal[vi], w.d1[vi]);
     out.k1[vi] = float(k1);
     out.k2[vi] = float(k2);
-    out.dir1[vi] = Vec3f(d1[vi]);
-    out.dir2[vi] = Vec3f(d2[vi]);
+    out.dir1[vi] = Vec3f(w.d1[vi]);
+    out.dir2[vi] = Vec3f(w.d2[vi]);
   });
+}
 
-  // Derivative tensor per face from curvature-tensor differences along the edges.
+/// Derivative tensor of one fitted face from curvature-tensor differences along its edges (least squares);
+/// false if the system is singular.
+bool fit_face_dtensor(const CurvatureWork& w, const MeshCurvature& out, std::size_t f, DTensor& result) {
+  const FaceFrame& ff = w.faces[f];
+  const auto& tri = w.mesh.triangles[f];
+  Tensor fk[3];
+  for (int j = 0; j < 3; ++j) {
+    const std::uint32_t vj = tri[j];
+    fk[j] = project_tensor(w.d1[vj], w.d2[vj], {out.k1[vj], 0.0, out.k2[vj]}, ff.t, ff.b);
+  }
+  double m[4] = {0, 0, 0, 0};
+  double a[4][4] = {};
+  for (int j = 0; j < 3; ++j) {
+    const Tensor& ka = fk[(j + 2) % 3];
+    const Tensor& kb = fk[(j + 1) % 3];
+    const double df[3] = {ka[0] - kb[0], ka[1] - kb[1], ka[2] - kb[2]};
+    const double eu = dot(ff.edge[j], ff.t), ev = dot(ff.edge[j], ff.b);
+    a[0][0] += eu * eu;
+    a[0][1] += eu * ev;
+    a[3][3] += ev * ev;
+    // The off-diagonal f appears twice in the tensor, so its equation carries weight 2 (trimesh2).
+    m[0] += eu * df[0];
+    m[1] += ev * df[0] + 2 * eu * df[1];
+    m[2] += 2 * ev * df[1] + eu * df[2];
+    m[3] += ev * df[2];
+  }
+  a[1][1] = 2 * a[0][0] + a[3][3];
+  a[1][2] = 2 * a[0][1];
+  a[2][2] = a[0][0] + 2 * a[3][3];
+  a[2][3] = a[0][1];
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < i; ++j) a[i][j] = a[j][i];
+  double x[4];
+  if (!solve_ldlt<4>(a, m, x)) return false;
+  result = {x[0], x[1], x[2], x[3]};
+  return true;
+}
+
+/// Curvature derivatives per vertex: the face derivative tensors gathered with corner-area weights.
+void compute_curvature_derivatives(const CurvatureWork& w, MeshCurvature& out) {
+  const std::size_t nf = w.mesh.triangle_count();
   std::vector<DTensor> face_c(nf);
   std::vector<std::uint8_t> has_c(nf, 0);
-  for_range(nf, threaded, [&](std::size_t f) {
-    const FaceFrame& ff = faces[f];
-    if (!ff.is_fitted) return;
-    const auto& tri = mesh.triangles[f];
-    Tensor fk[3];
-    for (int j = 0; j < 3; ++j) {
-      const std::uint32_t vj = tri[j];
-      fk[j] = project_tensor(d1[vj], d2[vj], {out.k1[vj], 0.0, out.k2[vj]}, ff.t, ff.b);
-    }
-    double m[4] = {0, 0, 0, 0};
-    double w[4][4] = {};
-    for (int j = 0; j < 3; ++j) {
-      const Tensor& ka = fk[(j + 2) % 3];
-      const Tensor& kb = fk[(j + 1) % 3];
-      const double df[3] = {ka[0] - kb[0], ka[1] - kb[1], ka[2] - kb[2]};
-      const double eu = dot(ff.edge[j], ff.t), ev = dot(ff.edge[j], ff.b);
-      w[0][0] += eu * eu;
-      w[0][1] += eu * ev;
-      w[3][3] += ev * ev;
-      // The off-diagonal f appears twice in the tensor, so its equation carries weight 2 (trimesh2).
-      m[0] += eu * df[0];
-      m[1] += ev * df[0] + 2 * eu * df[1];
-      m[2] += 2 * ev * df[1] + eu * df[2];
-      m[3] += ev * df[2];
-    }
-    w[1][1] = 2 * w[0][0] + w[3][3];
-    w[1][2] = 2 * w[0][1];
-    w[2][2] = w[0][0] + 2 * w[3][3];
-    w[2][3] = w[0][1];
-    for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < i; ++j) w[i][j] = w[j][i];
-    double x[4];
-    if (!solve_ldlt<4>(w, m, x)) return;
-    face_c[f] = {x[0], x[1], x[2], x[3]};
-    has_c[f] = 1;
+  w.for_faces([&](std::size_t f) {
+    if (w.faces[f].is_fitted) has_c[f] = fit_face_dtensor(w, out, f, face_c[f]) ? 1 : 0;
   });
-  out.dcurv.assign(nv, {0, 0, 0, 0});
-  for_range(nv, threaded, [&](std::size_t vi) {
+  out.dcurv.assign(w.mesh.vertex_count(), {0, 0, 0, 0});
+  w.for_vertices([&](std::size_t vi) {
     if (!out.is_valid[vi]) return;
     DTensor sum{0, 0, 0, 0};
     double weight = 0;
-    for (std::uint32_t c : vf.of(vi)) {
+    for (std::uint32_t c : w.vf.of(vi)) {
       if (!has_c[c / 3]) continue;
-      const FaceFrame& ff = faces[c / 3];
+      const FaceFrame& ff = w.faces[c / 3];
       const double wt = ff.corner_area[c % 3];
-      const DTensor p = project_dtensor(ff.t, ff.b, face_c[c / 3], d1[vi], d2[vi]);
+      const DTensor p = project_dtensor(ff.t, ff.b, face_c[c / 3], w.d1[vi], w.d2[vi]);
       for (int i = 0; i < 4; ++i) sum[i] += wt * p[i];
       weight += wt;
     }
     for (int i = 0; i < 4; ++i) out.dcurv[vi][i] = weight > 0 ? float(sum[i] / weight) : 0.0f;
   });
+}
 
-  for (std::size_t vi = 0; vi < nv; ++vi) {
+void check_finite(const MeshCurvature& out) {
+  for (std::size_t vi = 0; vi < out.k1.size(); ++vi) {
     const auto& c = out.dcurv[vi];
     if (!std::isfinite(out.k1[vi]) || !std::isfinite(out.k2[vi]) || !is_finite(out.dir1[vi]) ||
         !std::isfinite(c[0] + c[1] + c[2] + c[3]))
       throw SolverError("curvature: non-finite result at vertex " + std::to_string(vi));
   }
+}
+
+/// Rusinkiewicz (2004) on a mesh whose orientation is already outward: each stage fills its part of `out`.
+MeshCurvature compute_oriented(const TriMesh& mesh, const CurvatureOptions& options) {
+  MeshCurvature out;
+  CurvatureWork w{mesh, options.threaded, build_vertex_faces(mesh), {}, {}, {}, {}, {}, {}};
+  compute_face_frames(w, out);
+  compute_vertex_normals(w, out);
+  compute_initial_frames(w, out);
+  compute_principal_curvatures(w, fit_face_second_forms(w), out);
+  compute_curvature_derivatives(w, out);
+  check_finite(out);
   out.feature_size = compute_feature_size(out, mesh);
   return out;
 }

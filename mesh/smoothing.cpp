@@ -1,13 +1,11 @@
 #include "mesh/smoothing.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 
 #include "core/errors.h"
+#include "core/parallel.h"
 #include "mesh/mesh_analysis.h"
 #include "mesh/mesh_io.h"
 
@@ -20,16 +18,6 @@ namespace {
 struct Adjacency {
   std::vector<std::uint32_t> offsets, items;
 };
-
-template <typename Fn>
-void parallel_vertices(std::size_t n, bool threaded, const Fn& fn) {
-  if (!threaded) {
-    fn(std::size_t(0), n);
-    return;
-  }
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024),
-                    [&](const tbb::blocked_range<std::size_t>& r) { fn(r.begin(), r.end()); });
-}
 
 Adjacency build_adjacency(const TriMesh& mesh, const std::vector<VertexKind>& kinds, bool neighbours, bool threaded) {
   const std::size_t n = mesh.vertex_count();
@@ -54,7 +42,7 @@ Adjacency build_adjacency(const TriMesh& mesh, const std::vector<VertexKind>& ki
   Adjacency ring;
   ring.offsets = faces.offsets;
   ring.items.resize(faces.items.size());
-  parallel_vertices(n, threaded, [&](std::size_t begin, std::size_t end) {
+  parallel_ranges(n, [&](std::size_t begin, std::size_t end) {
     for (std::size_t v = begin; v < end; ++v) {
       std::uint32_t* out = ring.items.data() + ring.offsets[v];
       std::size_t k = 0;
@@ -65,7 +53,7 @@ Adjacency build_adjacency(const TriMesh& mesh, const std::vector<VertexKind>& ki
       }
       std::sort(out, out + k);  // fixed summation order, independent of the triangle order
     }
-  });
+  }, threaded, std::size_t(1024));
   return ring;
 }
 
@@ -101,7 +89,7 @@ TriMesh taubin_smooth(const TriMesh& mesh, const SmoothingOptions& options) {
 
   std::vector<Vec3f> current = mesh.positions, next(n);
   auto pass = [&](double step) {
-    parallel_vertices(n, options.threaded, [&](std::size_t begin, std::size_t end) {
+    parallel_ranges(n, [&](std::size_t begin, std::size_t end) {
       for (std::size_t v = begin; v < end; ++v) {
         const std::uint32_t b = adj.offsets[v], e = adj.offsets[v + 1];
         const Vec3d p(current[v]);
@@ -129,7 +117,7 @@ TriMesh taubin_smooth(const TriMesh& mesh, const SmoothingOptions& options) {
         }
         next[v] = weight > 0 ? Vec3f(p + (sum / weight - p) * step) : current[v];
       }
-    });
+    }, options.threaded, std::size_t(1024));
     std::swap(current, next);
   };
   for (int it = 0; it < options.iterations; ++it) {

@@ -14,6 +14,7 @@
 #include "core/camera.h"
 #include "core/vec.h"
 #include "core/tri_mesh.h"
+#include "core/tolerances.h"
 #include "nrr/depth_image.h"
 
 namespace raysift::nrr {
@@ -21,7 +22,7 @@ namespace raysift::nrr {
 struct ReconstructionOptions {
   /// Two samples are continuous if one's depth is within this fraction of the depth that the other's
   /// tangent plane predicts along its ray (0.5%: looser values bridge neighbouring grass blades).
-  double discontinuity_rel = 0.005;
+  double discontinuity_rel = tol::kDepthDiscontinuityRelative;
   /// ... and their normals (turned toward the camera) have a cosine above this.
   double normal_cos_min = 0.5;
   /// Estimated hybrid corners stay within this fraction of the sample's view depth.

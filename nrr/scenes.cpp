@@ -3,20 +3,14 @@
 #include <cmath>
 
 #include "core/errors.h"
+#include "core/hash.h"
 
 namespace raysift::nrr {
 namespace {
 
-std::uint64_t mix64(std::uint64_t x) {  // splitmix64 finaliser
-  x += 0x9e3779b97f4a7c15ull;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-  return x ^ (x >> 31);
-}
-
 /// Uniform in [0,1) from hash(element index, seed, stream): independent of generation order.
 double uniform(std::uint64_t index, std::uint64_t seed, std::uint64_t stream) {
-  return double(mix64(mix64(mix64(seed) ^ index) + stream) >> 11) * (1.0 / 9007199254740992.0);
+  return unit_double(mix64(mix64(mix64(seed) ^ index) + stream));
 }
 
 std::uint32_t add_vertex(TriMesh& m, const Vec3d& p) {

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/errors.h"
+#include "mesh/triangle_raster.h"
 #include "nrr/area_light.h"
 
 namespace raysift::nrr {
@@ -12,20 +13,6 @@ namespace raysift::nrr {
 namespace {
 constexpr double kMaxHalfAngleTan = 5.671281819617709;  // tan(80 deg): keeps texels from degenerating
 constexpr double kMaxSlopeTan = 10.0;                   // cap of tan(theta) in the slope bias
-
-// Twice the signed area of (a, b, p), written so that swapping a and b negates the result exactly in
-// floating point: the two products are the same numbers in either order. This makes the coverage
-// decision of a shared edge identical (with opposite sign) for both triangles that use it.
-inline double edge(double ax, double ay, double bx, double by, double px, double py) {
-  return (ax - px) * (by - py) - (ay - py) * (bx - px);
-}
-
-// Top-left rule: a texel centre exactly on an edge belongs to the triangle for which this is true;
-// for the same edge walked in the opposite direction it is false.
-inline bool owns_edge(double ax, double ay, double bx, double by) {
-  const double dx = bx - ax, dy = by - ay;
-  return dy > 0.0 || (dy == 0.0 && dx < 0.0);
-}
 }  // namespace
 
 ShadowFrustum fit_shadow_frustum(const Vec3d& eye_ws, Span<const Vec3d> points, const Vec3d& fallback_forward,
@@ -123,48 +110,20 @@ void ShadowMap::render(const ShadowFrustum& frustum, Span<const TriMesh* const> 
   }
 }
 
-void ShadowMap::rasterise(const double (&sx_in)[3], const double (&sy_in)[3], const double (&iz_in)[3]) {
+void ShadowMap::rasterise(const double (&sx)[3], const double (&sy)[3], const double (&iz)[3]) {
   const int res = frustum_.resolution;
-  // Texel (i, j) has its centre at (i + 0.5, j + 0.5). Most reconstruction triangles are smaller than
-  // a texel and cover no centre at all: reject them before any other set-up. Clamping before the
-  // conversion keeps far-off vertices from overflowing int.
-  auto texel_range = [res](double lo, double hi, int& first, int& last) {
-    first = int(std::ceil(std::clamp(lo, -1.0, double(res) + 1.0) - 0.5));
-    last = int(std::floor(std::clamp(hi, -1.0, double(res) + 1.0) - 0.5));
-    first = std::max(first, 0);
-    last = std::min(last, res - 1);
-    return first <= last;
-  };
+  // Most reconstruction triangles are smaller than a texel and cover no centre at all: reject them before
+  // any other set-up.
   int i_lo, i_hi, j_lo, j_hi;
-  if (!texel_range(std::min(sx_in[0], std::min(sx_in[1], sx_in[2])), std::max(sx_in[0], std::max(sx_in[1], sx_in[2])),
-                   i_lo, i_hi) ||
-      !texel_range(std::min(sy_in[0], std::min(sy_in[1], sy_in[2])), std::max(sy_in[0], std::max(sy_in[1], sy_in[2])),
-                   j_lo, j_hi))
+  if (!mesh::pixel_centre_range(std::min({sx[0], sx[1], sx[2]}), std::max({sx[0], sx[1], sx[2]}), res, i_lo, i_hi) ||
+      !mesh::pixel_centre_range(std::min({sy[0], sy[1], sy[2]}), std::max({sy[0], sy[1], sy[2]}), res, j_lo, j_hi))
     return;
-  const double area = edge(sx_in[0], sy_in[0], sx_in[1], sy_in[1], sx_in[2], sy_in[2]);
-  if (!(area != 0.0)) return;  // degenerate (or NaN): covers no texel centre
-  ++rasterised_;
-  // Both faces are drawn: order the vertices counter-clockwise in texel space.
-  const int i1 = area > 0 ? 1 : 2, i2 = area > 0 ? 2 : 1;
-  const double x0 = sx_in[0], y0 = sy_in[0], x1 = sx_in[i1], y1 = sy_in[i1], x2 = sx_in[i2], y2 = sy_in[i2];
-  const double z0 = iz_in[0], z1 = iz_in[i1], z2 = iz_in[i2];
-  const double inv_area = 1.0 / std::abs(area);
-  const bool own0 = owns_edge(x1, y1, x2, y2), own1 = owns_edge(x2, y2, x0, y0), own2 = owns_edge(x0, y0, x1, y1);
-  for (int j = j_lo; j <= j_hi; ++j) {
-    const double py = j + 0.5;
-    float* row = inv_depth_.data() + std::size_t(j) * std::size_t(res);
-    for (int i = i_lo; i <= i_hi; ++i) {
-      const double px = i + 0.5;
-      const double w0 = edge(x1, y1, x2, y2, px, py);
-      const double w1 = edge(x2, y2, x0, y0, px, py);
-      const double w2 = edge(x0, y0, x1, y1, px, py);
-      if (w0 < 0.0 || w1 < 0.0 || w2 < 0.0) continue;
-      if ((w0 == 0.0 && !own0) || (w1 == 0.0 && !own1) || (w2 == 0.0 && !own2)) continue;
-      // 1/z is affine in texel space (perspective-correct depth); the nearest surface has the largest.
-      const float inv_z = float((w0 * z0 + w1 * z1 + w2 * z2) * inv_area);
-      if (inv_z > row[i]) row[i] = inv_z;
-    }
-  }
+  // The nearest surface has the largest 1/z.
+  const bool drawn = mesh::rasterize_triangle(sx, sy, iz, i_lo, i_hi, j_lo, j_hi, [&](int i, int j, double inv_z) {
+    float& texel = inv_depth_[std::size_t(j) * std::size_t(res) + std::size_t(i)];
+    if (float(inv_z) > texel) texel = float(inv_z);
+  });
+  if (drawn) ++rasterised_;
 }
 
 bool ShadowMap::is_lit(const Vec3d& p_ws, const Vec3d& normal, const ShadowBias& bias) const {

@@ -9,13 +9,12 @@
 #include <cmath>
 
 #include "core/errors.h"
+#include "core/tolerances.h"
 #include "core/timer.h"
 
 namespace raysift::nrr {
 
 namespace {
-// Relative: shadow rays stop this fraction short of the light sample (ALGORITHMS.md §9, eps_r).
-constexpr double kShadowRayEndRel = 1e-4;
 // Relative to the scene diagonal: near plane of the shadow-map frusta (a light sample sits on the
 // light plane, so only geometry that close to the sample is clipped).
 constexpr double kShadowNearRel = 1e-5;
@@ -177,7 +176,7 @@ VisibilitySet raytraced_visibility(const mesh::RayScene& scene, const Receivers&
         for (int s = 0; s < n_samples; ++s) {
           if (!can_receive(light, pos, nrm, samples_ws[std::size_t(s)])) continue;
           rays.push_back(mesh::RayF{Vec3f(origin), Vec3f(samples_ws[std::size_t(s)] - origin), 0.0f,
-                                    float(1.0 - kShadowRayEndRel)});
+                                    float(1.0 - tol::kSegmentEndRelative)});
           ray_sample.push_back(s);
         }
         blocked.assign(rays.size(), 0);
@@ -248,7 +247,7 @@ std::vector<CameraSpec> light_corner_views(const AreaLight& light, const Bbox3d&
     for (const Vec3d& c : box_corners(bounds)) {
       const Vec3d d = c - eyes[i];
       const double z = dot(d, forward);
-      if (z <= 1e-6 * diag) {
+      if (z <= tol::kNearPlaneRelative * diag) {
         clipped = true;
         continue;
       }

@@ -13,6 +13,7 @@
 
 #include "core/camera.h"
 #include "core/span.h"
+#include "core/tolerances.h"
 #include "core/vec.h"
 #include "mesh/ray_scene.h"
 #include "core/tri_mesh.h"
@@ -60,7 +61,8 @@ struct ShadowOptions {
   ShadowFit fit = ShadowFit::SceneBounds;
   double bias_constant_rel = 1e-4;  ///< constant shadow-map bias, relative to the scene diagonal
   double bias_slope_texels = 1.5;   ///< slope-scaled bias, texels (see ShadowBias)
-  double ray_offset_rel = 1e-4;     ///< shadow-ray origin offset along the normal, relative to the diagonal
+  /// shadow-ray origin offset along the normal, relative to the diagonal
+  double ray_offset_rel = tol::kRayOffsetRelative;
   int depth_image_resolution = 1024;  ///< conventional/nrr/peel depth images, pixels per side
   SamplingMode nrr_redundancy = SamplingMode::NrrVisibility;  ///< NrrPixel or NrrVisibility
   ReconstructionKind reconstruction_kind = ReconstructionKind::Auto;

@@ -1,8 +1,5 @@
 #include "sampling/camera_path.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <array>
 #include <atomic>
 #include <cmath>
@@ -11,8 +8,10 @@
 #include <optional>
 #include <sstream>
 
+#include "core/bilinear.h"
 #include "core/errors.h"
 #include "core/file_util.h"
+#include "core/parallel.h"
 #include "core/timer.h"
 #include "features/warp.h"
 #include "sampling/frame_rate.h"
@@ -68,24 +67,6 @@ std::pair<std::size_t, std::size_t> find_conversion(const std::string& pattern, 
     }
   }
   return found;
-}
-
-/// Bilinear taps along one axis for reading a map of `n_map` pixels at the centres of `n_frame` frame
-/// pixels (both cover the same extent); clamped at the border.
-struct Taps {
-  std::vector<int> lo, hi;
-  std::vector<float> t;
-};
-
-Taps bilinear_taps(int n_frame, int n_map) {
-  Taps taps;
-  for (int i = 0; i < n_frame; ++i) {
-    const double f = std::clamp((i + 0.5) * n_map / n_frame - 0.5, 0.0, double(n_map - 1));
-    taps.lo.push_back(int(f));
-    taps.hi.push_back(std::min(int(f) + 1, n_map - 1));
-    taps.t.push_back(float(f - int(f)));
-  }
-  return taps;
 }
 
 /// Every ray traced since the camera last moved: colour, depth and whether it is known. A still camera
@@ -287,19 +268,11 @@ ImageF path_frame_importance(const volume::RayCaster& caster, const FeatureGeome
       features::warp_map(map, features::downsample_depth(previous->depth, map.width, map.height),
                          Camera(previous->camera), caster.camera(), warp);
   const int w = importance.width, h = importance.height;
-  const Taps tx = bilinear_taps(w, warped.map.width), ty = bilinear_taps(h, warped.map.height);
-  const ImageF& m = warped.map;
-  tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
-    for (int y = rows.begin(); y < rows.end(); ++y) {
-      const std::size_t j = std::size_t(y);
-      for (int x = 0; x < w; ++x) {
-        if (importance(x, y) < 0.f) continue;  // background stays background
-        const std::size_t i = std::size_t(x);
-        const float top = m(tx.lo[i], ty.lo[j]) + tx.t[i] * (m(tx.hi[i], ty.lo[j]) - m(tx.lo[i], ty.lo[j]));
-        const float bottom = m(tx.lo[i], ty.hi[j]) + tx.t[i] * (m(tx.hi[i], ty.hi[j]) - m(tx.lo[i], ty.hi[j]));
-        importance(x, y) = std::max(importance(x, y), top + ty.t[j] * (bottom - top));
-      }
-    }
+  const BilinearTaps tx = bilinear_taps(w, warped.map.width), ty = bilinear_taps(h, warped.map.height);
+  parallel_rows(h, [&](int y) {
+    for (int x = 0; x < w; ++x)
+      if (importance(x, y) >= 0.f)  // background stays background
+        importance(x, y) = std::max(importance(x, y), bilinear_at(warped.map, tx, ty, x, y));
   });
   if (saliency_ms != nullptr) *saliency_ms = timer.elapsed_ms();
   return importance;

@@ -2,14 +2,14 @@
 // in ALGORITHMS.md section 7.3; it is an independent implementation, not a copy.
 #include "sampling/metrics.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
 #include <vector>
+
+#include "core/colour.h"
+#include "core/parallel.h"
 
 namespace raysift::sampling {
 namespace {
@@ -41,43 +41,21 @@ std::array<float, 3> display_rgb(const Rgba& p) {
   return {linear_to_srgb(p.r), linear_to_srgb(p.g), linear_to_srgb(p.b)};
 }
 
-// ---- FLIP colour spaces (linear sRGB primaries, D65) ----
-using Mat3 = std::array<std::array<double, 3>, 3>;
+// ---- FLIP colour spaces (core/colour.h's linear sRGB and XYZ, in float as in FLIP) ----
 using Col3 = std::array<float, 3>;
-
-constexpr Mat3 kRgbToXyz = {{{10135552.0 / 24577794.0, 8788810.0 / 24577794.0, 4435075.0 / 24577794.0},
-                             {2613072.0 / 12288897.0, 8788810.0 / 12288897.0, 887015.0 / 12288897.0},
-                             {1425312.0 / 73733382.0, 8788810.0 / 73733382.0, 70074185.0 / 73733382.0}}};
-
-Mat3 inverse(const Mat3& m) {
-  const double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
-                     m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-                     m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-  Mat3 r{};
-  r[0][0] = (m[1][1] * m[2][2] - m[1][2] * m[2][1]) / det;
-  r[0][1] = (m[0][2] * m[2][1] - m[0][1] * m[2][2]) / det;
-  r[0][2] = (m[0][1] * m[1][2] - m[0][2] * m[1][1]) / det;
-  r[1][0] = (m[1][2] * m[2][0] - m[1][0] * m[2][2]) / det;
-  r[1][1] = (m[0][0] * m[2][2] - m[0][2] * m[2][0]) / det;
-  r[1][2] = (m[0][2] * m[1][0] - m[0][0] * m[1][2]) / det;
-  r[2][0] = (m[1][0] * m[2][1] - m[1][1] * m[2][0]) / det;
-  r[2][1] = (m[0][1] * m[2][0] - m[0][0] * m[2][1]) / det;
-  r[2][2] = (m[0][0] * m[1][1] - m[0][1] * m[1][0]) / det;
-  return r;
-}
 
 struct FlipColour {
   std::array<std::array<float, 3>, 3> to_xyz{}, to_rgb{};
   Col3 white{};  // XYZ of linear white (1,1,1): the reference illuminant
 
   FlipColour() {
-    const Mat3 inv = inverse(kRgbToXyz);
+    const Colour3 w = d65_white_xyz();
     for (int i = 0; i < 3; ++i) {
       for (int j = 0; j < 3; ++j) {
-        to_xyz[i][j] = float(kRgbToXyz[i][j]);
-        to_rgb[i][j] = float(inv[i][j]);
+        to_xyz[i][j] = float(kLinearSrgbToXyz[i][j]);
+        to_rgb[i][j] = float(xyz_to_linear_srgb_matrix()[i][j]);
       }
-      white[i] = float(kRgbToXyz[i][0] + kRgbToXyz[i][1] + kRgbToXyz[i][2]);
+      white[i] = float(w[i]);
     }
   }
   static Col3 apply(const std::array<std::array<float, 3>, 3>& m, const Col3& v) {
@@ -94,14 +72,9 @@ struct FlipColour {
     const Col3 xyz = {(y + c[1] / 500.0f) * white[0], y * white[1], (y - c[2] / 200.0f) * white[2]};
     return apply(to_rgb, xyz);
   }
-  Col3 rgb_to_lab(const Col3& rgb) const {
-    const Col3 xyz = apply(to_xyz, rgb);
-    constexpr float delta = 6.0f / 29.0f;
-    auto f = [&](float t) {
-      return t > delta * delta * delta ? std::cbrt(t) : t / (3.0f * delta * delta) + 4.0f / 29.0f;
-    };
-    const float fx = f(xyz[0] / white[0]), fy = f(xyz[1] / white[1]), fz = f(xyz[2] / white[2]);
-    return {116.0f * fy - 16.0f, 500.0f * (fx - fy), 200.0f * (fy - fz)};
+  static Col3 rgb_to_lab(const Col3& rgb) {
+    const Colour3 lab = linear_srgb_to_cielab({rgb[0], rgb[1], rgb[2]});
+    return {float(lab[0]), float(lab[1]), float(lab[2])};
   }
   // Hunt-adjusted Lab: chroma scaled by 0.01 L*.
   Col3 hunt_lab(const Col3& rgb) const {
@@ -123,12 +96,162 @@ float csf(float x_deg, float a, float b) {
   return a * std::sqrt(float(kPi) / b) * std::exp(-float(kPi * kPi) * x_deg * x_deg / b);
 }
 
-// Runs fn(x, y) for every pixel, rows in parallel; each call writes only its own pixel.
-template <typename Fn>
-void for_each_pixel(int w, int h, Fn&& fn) {
-  tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
-    for (int y = rows.begin(); y < rows.end(); ++y)
-      for (int x = 0; x < w; ++x) fn(x, y);
+// ---- FLIP stages (each one image or one pass, so reference and test share the code) ----
+using Four = std::array<float, 4>;
+using Three = std::array<float, 3>;
+
+std::size_t at(int w, int x, int y) { return std::size_t(y) * std::size_t(w) + std::size_t(x); }
+
+/// One separable filter pass at position `pos` of an axis of n pixels: tap(acc, fi, i) for the taps fi in
+/// [0, 2 radius] in order, i the neighbour index clamped to the axis (borders replicated).
+template <typename Acc, typename F>
+Acc filter_at(int radius, int pos, int n, const F& tap) {
+  Acc acc{};
+  for (int k = -radius; k <= radius; ++k) tap(acc, k + radius, std::min(std::max(0, pos + k), n - 1));
+  return acc;
+}
+
+/// Linear RGB clamped to [0,1], then YCxCz.
+std::vector<Col3> to_ycxcz(const ImageRGBA& image) {
+  static const FlipColour colour;
+  std::vector<Col3> out(image.size());
+  parallel_ranges(image.size(), [&](std::size_t begin, std::size_t end) {
+    auto clamp01 = [](float v) { return std::min(1.0f, std::max(0.0f, v)); };
+    for (std::size_t i = begin; i < end; ++i) {
+      const Rgba& p = image.pixels[i];
+      out[i] = colour.rgb_to_ycxcz({clamp01(p.r), clamp01(p.g), clamp01(p.b)});
+    }
+  });
+  return out;
+}
+
+/// Spatial CSF filters, separable. The blue-yellow filter is a sum of two Gaussians, so it runs as two
+/// separable filters with sqrt amplitudes whose 2D results are added.
+struct CsfFilters {
+  int radius;
+  std::vector<float> y, cx, cz1, cz2;
+
+  explicit CsfFilters(float ppd) {
+    constexpr float b_max = 0.04f;
+    radius = int(std::ceil(3.0f * std::sqrt(b_max / (2.0f * float(kPi * kPi))) * ppd));
+    const int sw = 2 * radius + 1;
+    y.resize(sw), cx.resize(sw), cz1.resize(sw), cz2.resize(sw);
+    float sum_y = 0, sum_cx = 0, sum_cz1 = 0, sum_cz2 = 0;
+    for (int i = 0; i < sw; ++i) {
+      const float x = float(i - radius) / ppd;
+      sum_y += y[i] = csf(x, 1.0f, 0.0047f);
+      sum_cx += cx[i] = csf(x, 1.0f, 0.0053f);
+      sum_cz1 += cz1[i] = std::sqrt(34.1f * std::sqrt(float(kPi) / 0.04f)) * std::exp(-float(kPi * kPi) * x * x / 0.04f);
+      sum_cz2 += cz2[i] = std::sqrt(13.5f * std::sqrt(float(kPi) / 0.025f)) * std::exp(-float(kPi * kPi) * x * x / 0.025f);
+    }
+    const float norm_cz = 1.0f / std::sqrt(sum_cz1 * sum_cz1 + sum_cz2 * sum_cz2);
+    for (int i = 0; i < sw; ++i) {
+      y[i] /= sum_y;
+      cx[i] /= sum_cx;
+      cz1[i] *= norm_cz;
+      cz2[i] *= norm_cz;
+    }
+  }
+};
+
+/// Horizontal CSF pass: Y, Cx, Cz-part-1, Cz-part-2 per pixel (borders replicated).
+std::vector<Four> csf_rows(const std::vector<Col3>& ycc, int w, int h, const CsfFilters& f) {
+  std::vector<Four> mid(ycc.size());
+  parallel_pixels(w, h, [&](int x, int y) {
+    mid[at(w, x, y)] = filter_at<Four>(f.radius, x, w, [&](Four& m, int fi, int xx) {
+      const Col3& c = ycc[at(w, xx, y)];
+      m[0] += f.y[fi] * c[0];
+      m[1] += f.cx[fi] * c[1];
+      m[2] += f.cz1[fi] * c[2];
+      m[3] += f.cz2[fi] * c[2];
+    });
+  });
+  return mid;
+}
+
+/// Vertical CSF pass at one pixel, back to linear RGB clamped to [0,1], as Hunt-adjusted Lab.
+Col3 csf_column_hunt_lab(const std::vector<Four>& mid, int w, int h, const CsfFilters& f, int x, int y) {
+  static const FlipColour colour;
+  const Four m = filter_at<Four>(f.radius, y, h, [&](Four& acc, int fi, int yy) {
+    const Four& c = mid[at(w, x, yy)];
+    acc[0] += f.y[fi] * c[0];
+    acc[1] += f.cx[fi] * c[1];
+    acc[2] += f.cz1[fi] * c[2];
+    acc[3] += f.cz2[fi] * c[3];
+  });
+  Col3 rgb = colour.ycxcz_to_rgb({m[0], m[1], m[2] + m[3]});
+  for (float& c : rgb) c = std::min(1.0f, std::max(0.0f, c));
+  return colour.hunt_lab(rgb);
+}
+
+/// FLIP's colour error per pixel: HyAB distance of the CSF-filtered images, compressed to [0,1].
+std::vector<float> colour_error(const std::vector<Col3>& ref_ycc, const std::vector<Col3>& test_ycc, int w, int h,
+                                const CsfFilters& f) {
+  static const FlipColour colour;
+  const std::vector<Four> ref_mid = csf_rows(ref_ycc, w, h, f), test_mid = csf_rows(test_ycc, w, h, f);
+  const float cmax = std::pow(hyab(colour.hunt_lab({0, 1, 0}), colour.hunt_lab({0, 0, 1})), kGqc);
+  const float pccmax = kGpc * cmax;
+  std::vector<float> error(ref_ycc.size());
+  parallel_pixels(w, h, [&](int x, int y) {
+    const Col3 a = csf_column_hunt_lab(ref_mid, w, h, f, x, y), b = csf_column_hunt_lab(test_mid, w, h, f, x, y);
+    float e = std::pow(hyab(a, b), kGqc);
+    e = e < pccmax ? e * kGpt / pccmax : kGpt + (e - pccmax) / (cmax - pccmax) * (1.0f - kGpt);
+    error[at(w, x, y)] = e;
+  });
+  return error;
+}
+
+/// Edge and point detectors: a Gaussian and its first and second derivatives, in pixels.
+struct FeatureFilters {
+  int radius;
+  std::vector<float> g, dg, ddg;
+
+  explicit FeatureFilters(float ppd) {
+    const float sigma = 0.5f * kGw * ppd;
+    radius = int(std::ceil(3.0f * sigma));
+    const int fw = 2 * radius + 1;
+    g.resize(fw), dg.resize(fw), ddg.resize(fw);
+    float g_sum = 0, dg_pos = 0, dg_neg = 0, ddg_pos = 0, ddg_neg = 0;
+    for (int i = 0; i < fw; ++i) {
+      const float x = float(i - radius);
+      g[i] = std::exp(-x * x / (2.0f * sigma * sigma));
+      g_sum += g[i];
+      dg[i] = -x * g[i];
+      (dg[i] > 0 ? dg_pos : dg_neg) += std::fabs(dg[i]);
+      ddg[i] = (x * x / (sigma * sigma) - 1.0f) * g[i];
+      (ddg[i] > 0 ? ddg_pos : ddg_neg) += std::fabs(ddg[i]);
+    }
+    // Gaussian sums to 1; positive and negative derivative weights sum to +1 and -1.
+    for (int i = 0; i < fw; ++i) {
+      g[i] /= g_sum;
+      dg[i] /= dg[i] > 0 ? dg_pos : dg_neg;
+      ddg[i] /= ddg[i] > 0 ? ddg_pos : ddg_neg;
+    }
+  }
+};
+
+/// Horizontal feature pass on the achromatic channel normalised to [0,1]: d/dx, d2/dx2, Gaussian along x.
+std::vector<Three> feature_rows(const std::vector<Col3>& ycc, int w, int h, const FeatureFilters& f) {
+  std::vector<Three> out(ycc.size());
+  parallel_pixels(w, h, [&](int x, int y) {
+    out[at(w, x, y)] = filter_at<Three>(f.radius, x, w, [&](Three& t, int fi, int xx) {
+      const float v = (ycc[at(w, xx, y)][0] + 16.0f) / 116.0f;
+      t[0] += f.dg[fi] * v;
+      t[1] += f.ddg[fi] * v;
+      t[2] += f.g[fi] * v;
+    });
+  });
+  return out;
+}
+
+/// Vertical feature pass at one pixel: {dx, ddx, dy, ddy}.
+Four feature_column(const std::vector<Three>& rows, int w, int h, const FeatureFilters& f, int x, int y) {
+  return filter_at<Four>(f.radius, y, h, [&](Four& d, int fi, int yy) {
+    const Three& t = rows[at(w, x, yy)];
+    d[0] += f.g[fi] * t[0];
+    d[1] += f.g[fi] * t[1];
+    d[2] += f.dg[fi] * t[2];
+    d[3] += f.ddg[fi] * t[2];
   });
 }
 
@@ -200,36 +323,35 @@ ImageF ssim_map(const ImageRGBA& a, const ImageRGBA& b, SsimSignal signal) {
   // Horizontal pass: five moments (x, y, x^2, y^2, xy) for the columns with a full window.
   const int vw = w - 2 * kRadius;
   std::vector<std::array<double, 5>> horizontal(std::size_t(vw) * std::size_t(h));
-  tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
-    for (int y = rows.begin(); y < rows.end(); ++y)
-      for (int x = 0; x < vw; ++x) {
-        std::array<double, 5> m{};
-        for (int k = 0; k <= 2 * kRadius; ++k) {
-          const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x + k);
-          const double wk = weights[k], va = ya[i], vb = yb[i];
-          m[0] += wk * va;
-          m[1] += wk * vb;
-          m[2] += wk * va * va;
-          m[3] += wk * vb * vb;
-          m[4] += wk * va * vb;
-        }
-        horizontal[std::size_t(y) * std::size_t(vw) + std::size_t(x)] = m;
+  parallel_rows(h, [&](int y) {
+    for (int x = 0; x < vw; ++x) {
+      std::array<double, 5> m{};
+      for (int k = 0; k <= 2 * kRadius; ++k) {
+        const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x + k);
+        const double wk = weights[k], va = ya[i], vb = yb[i];
+        m[0] += wk * va;
+        m[1] += wk * vb;
+        m[2] += wk * va * va;
+        m[3] += wk * vb * vb;
+        m[4] += wk * va * vb;
       }
+      horizontal[std::size_t(y) * std::size_t(vw) + std::size_t(x)] = m;
+    }
   });
-  tbb::parallel_for(tbb::blocked_range<int>(kRadius, h - kRadius), [&](const tbb::blocked_range<int>& rows) {
-    for (int y = rows.begin(); y < rows.end(); ++y)
-      for (int x = 0; x < vw; ++x) {
-        std::array<double, 5> m{};
-        for (int k = 0; k <= 2 * kRadius; ++k) {
-          const auto& hm = horizontal[std::size_t(y - kRadius + k) * std::size_t(vw) + std::size_t(x)];
-          for (int c = 0; c < 5; ++c) m[c] += weights[k] * hm[c];
-        }
-        const double mu_a = m[0], mu_b = m[1];
-        const double var_a = m[2] - mu_a * mu_a, var_b = m[3] - mu_b * mu_b, cov = m[4] - mu_a * mu_b;
-        const double s = ((2 * mu_a * mu_b + kC1) * (2 * cov + kC2)) /
-                         ((mu_a * mu_a + mu_b * mu_b + kC1) * (var_a + var_b + kC2));
-        out(x + kRadius, y) = float(s);
+  parallel_rows(h - 2 * kRadius, [&](int row) {
+    const int y = row + kRadius;
+    for (int x = 0; x < vw; ++x) {
+      std::array<double, 5> m{};
+      for (int k = 0; k <= 2 * kRadius; ++k) {
+        const auto& hm = horizontal[std::size_t(y - kRadius + k) * std::size_t(vw) + std::size_t(x)];
+        for (int c = 0; c < 5; ++c) m[c] += weights[k] * hm[c];
       }
+      const double mu_a = m[0], mu_b = m[1];
+      const double var_a = m[2] - mu_a * mu_a, var_b = m[3] - mu_b * mu_b, cov = m[4] - mu_a * mu_b;
+      const double s = ((2 * mu_a * mu_b + kC1) * (2 * cov + kC2)) /
+                       ((mu_a * mu_a + mu_b * mu_b + kC1) * (var_a + var_b + kC2));
+      out(x + kRadius, y) = float(s);
+    }
   });
   return out;
 }
@@ -239,161 +361,18 @@ ImageF flip_map(const ImageRGBA& reference, const ImageRGBA& test, double ppd_in
   if (!(ppd_in > 0) || !std::isfinite(ppd_in)) throw InvalidInput("FLIP pixels per degree must be > 0");
   const float ppd = float(ppd_in);
   const int w = reference.width, h = reference.height;
-  const std::size_t n = reference.size();
-  static const FlipColour colour;
-
-  // Inputs as linear RGB clamped to [0,1], then YCxCz.
-  std::vector<Col3> ref_ycc(n), test_ycc(n);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n), [&](const tbb::blocked_range<std::size_t>& r) {
-    auto clamp01 = [](float v) { return std::min(1.0f, std::max(0.0f, v)); };
-    for (std::size_t i = r.begin(); i < r.end(); ++i) {
-      const Rgba& p = reference.pixels[i];
-      const Rgba& q = test.pixels[i];
-      ref_ycc[i] = colour.rgb_to_ycxcz({clamp01(p.r), clamp01(p.g), clamp01(p.b)});
-      test_ycc[i] = colour.rgb_to_ycxcz({clamp01(q.r), clamp01(q.g), clamp01(q.b)});
-    }
-  });
-
-  // Spatial CSF filters, separable. The blue-yellow filter is a sum of two Gaussians, so it runs as
-  // two separable filters with sqrt amplitudes whose 2D results are added.
-  constexpr float b_max = 0.04f;
-  const int sr = int(std::ceil(3.0f * std::sqrt(b_max / (2.0f * float(kPi * kPi))) * ppd));
-  const int sw = 2 * sr + 1;
-  std::vector<float> f_y(sw), f_cx(sw), f_cz1(sw), f_cz2(sw);
-  {
-    float sum_y = 0, sum_cx = 0, sum_cz1 = 0, sum_cz2 = 0;
-    for (int i = 0; i < sw; ++i) {
-      const float x = float(i - sr) / ppd;
-      sum_y += f_y[i] = csf(x, 1.0f, 0.0047f);
-      sum_cx += f_cx[i] = csf(x, 1.0f, 0.0053f);
-      sum_cz1 += f_cz1[i] = std::sqrt(34.1f * std::sqrt(float(kPi) / 0.04f)) *
-                            std::exp(-float(kPi * kPi) * x * x / 0.04f);
-      sum_cz2 += f_cz2[i] = std::sqrt(13.5f * std::sqrt(float(kPi) / 0.025f)) *
-                            std::exp(-float(kPi * kPi) * x * x / 0.025f);
-    }
-    const float norm_cz = 1.0f / std::sqrt(sum_cz1 * sum_cz1 + sum_cz2 * sum_cz2);
-    for (int i = 0; i < sw; ++i) {
-      f_y[i] /= sum_y;
-      f_cx[i] /= sum_cx;
-      f_cz1[i] *= norm_cz;
-      f_cz2[i] *= norm_cz;
-    }
-  }
-  // Intermediate per pixel: Y, Cx, Cz-part-1, Cz-part-2 for reference and test.
-  using Four = std::array<float, 4>;
-  std::vector<Four> ref_mid(n), test_mid(n);
-  for_each_pixel(w, h, [&, r = sr](int x, int y) {
-    Four mr{}, mt{};
-    for (int k = -r; k <= r; ++k) {
-      const int xx = std::min(std::max(0, x + k), w - 1);
-      const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(xx);
-      const int fi = k + r;
-      mr[0] += f_y[fi] * ref_ycc[i][0];
-      mr[1] += f_cx[fi] * ref_ycc[i][1];
-      mr[2] += f_cz1[fi] * ref_ycc[i][2];
-      mr[3] += f_cz2[fi] * ref_ycc[i][2];
-      mt[0] += f_y[fi] * test_ycc[i][0];
-      mt[1] += f_cx[fi] * test_ycc[i][1];
-      mt[2] += f_cz1[fi] * test_ycc[i][2];
-      mt[3] += f_cz2[fi] * test_ycc[i][2];
-    }
-    ref_mid[std::size_t(y) * std::size_t(w) + std::size_t(x)] = mr;
-    test_mid[std::size_t(y) * std::size_t(w) + std::size_t(x)] = mt;
-  });
-
-  Col3 green_lab = colour.hunt_lab({0, 1, 0}), blue_lab = colour.hunt_lab({0, 0, 1});
-  const float cmax = std::pow(hyab(green_lab, blue_lab), kGqc);
-  const float pccmax = kGpc * cmax;
-  std::vector<float> colour_error(n);
-  for_each_pixel(w, h, [&, r = sr](int x, int y) {
-    Four mr{}, mt{};
-    for (int k = -r; k <= r; ++k) {
-      const int yy = std::min(std::max(0, y + k), h - 1);
-      const std::size_t i = std::size_t(yy) * std::size_t(w) + std::size_t(x);
-      const int fi = k + r;
-      mr[0] += f_y[fi] * ref_mid[i][0];
-      mr[1] += f_cx[fi] * ref_mid[i][1];
-      mr[2] += f_cz1[fi] * ref_mid[i][2];
-      mr[3] += f_cz2[fi] * ref_mid[i][3];
-      mt[0] += f_y[fi] * test_mid[i][0];
-      mt[1] += f_cx[fi] * test_mid[i][1];
-      mt[2] += f_cz1[fi] * test_mid[i][2];
-      mt[3] += f_cz2[fi] * test_mid[i][3];
-    }
-    auto to_hunt_lab = [&](const Four& m) {
-      Col3 rgb = colour.ycxcz_to_rgb({m[0], m[1], m[2] + m[3]});
-      for (float& c : rgb) c = std::min(1.0f, std::max(0.0f, c));
-      return colour.hunt_lab(rgb);
-    };
-    float e = std::pow(hyab(to_hunt_lab(mr), to_hunt_lab(mt)), kGqc);
-    e = e < pccmax ? e * kGpt / pccmax : kGpt + (e - pccmax) / (cmax - pccmax) * (1.0f - kGpt);
-    colour_error[std::size_t(y) * std::size_t(w) + std::size_t(x)] = e;
-  });
-
-  // Edge and point detectors on the achromatic channel normalised to [0,1].
-  const float sigma = 0.5f * kGw * ppd;
-  const int fr = int(std::ceil(3.0f * sigma));
-  const int fw = 2 * fr + 1;
-  std::vector<float> g(fw), dg(fw), ddg(fw);
-  {
-    float g_sum = 0, dg_pos = 0, dg_neg = 0, ddg_pos = 0, ddg_neg = 0;
-    for (int i = 0; i < fw; ++i) {
-      const float x = float(i - fr);
-      g[i] = std::exp(-x * x / (2.0f * sigma * sigma));
-      g_sum += g[i];
-      dg[i] = -x * g[i];
-      (dg[i] > 0 ? dg_pos : dg_neg) += std::fabs(dg[i]);
-      ddg[i] = (x * x / (sigma * sigma) - 1.0f) * g[i];
-      (ddg[i] > 0 ? ddg_pos : ddg_neg) += std::fabs(ddg[i]);
-    }
-    // Gaussian sums to 1; positive and negative derivative weights sum to +1 and -1.
-    for (int i = 0; i < fw; ++i) {
-      g[i] /= g_sum;
-      dg[i] /= dg[i] > 0 ? dg_pos : dg_neg;
-      ddg[i] /= ddg[i] > 0 ? ddg_pos : ddg_neg;
-    }
-  }
-  using Three = std::array<float, 3>;  // d/dx, d2/dx2, Gaussian along x
-  std::vector<Three> ref_feat(n), test_feat(n);
-  for_each_pixel(w, h, [&, r = fr](int x, int y) {
-    Three fref{}, ft{};
-    for (int k = -r; k <= r; ++k) {
-      const int xx = std::min(std::max(0, x + k), w - 1);
-      const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(xx);
-      const int fi = k + r;
-      const float vr = (ref_ycc[i][0] + 16.0f) / 116.0f, vt = (test_ycc[i][0] + 16.0f) / 116.0f;
-      fref[0] += dg[fi] * vr;
-      fref[1] += ddg[fi] * vr;
-      fref[2] += g[fi] * vr;
-      ft[0] += dg[fi] * vt;
-      ft[1] += ddg[fi] * vt;
-      ft[2] += g[fi] * vt;
-    }
-    ref_feat[std::size_t(y) * std::size_t(w) + std::size_t(x)] = fref;
-    test_feat[std::size_t(y) * std::size_t(w) + std::size_t(x)] = ft;
-  });
-
+  const std::vector<Col3> ref_ycc = to_ycxcz(reference), test_ycc = to_ycxcz(test);
+  const std::vector<float> colour = colour_error(ref_ycc, test_ycc, w, h, CsfFilters(ppd));
+  const FeatureFilters ff(ppd);
+  const std::vector<Three> ref_feat = feature_rows(ref_ycc, w, h, ff), test_feat = feature_rows(test_ycc, w, h, ff);
   ImageF out(w, h, 0.0f);
-  for_each_pixel(w, h, [&, r = fr](int x, int y) {
-    float dxr = 0, ddxr = 0, dyr = 0, ddyr = 0, dxt = 0, ddxt = 0, dyt = 0, ddyt = 0;
-    for (int k = -r; k <= r; ++k) {
-      const int yy = std::min(std::max(0, y + k), h - 1);
-      const std::size_t i = std::size_t(yy) * std::size_t(w) + std::size_t(x);
-      const int fi = k + r;
-      dxr += g[fi] * ref_feat[i][0];
-      ddxr += g[fi] * ref_feat[i][1];
-      dyr += dg[fi] * ref_feat[i][2];
-      ddyr += ddg[fi] * ref_feat[i][2];
-      dxt += g[fi] * test_feat[i][0];
-      ddxt += g[fi] * test_feat[i][1];
-      dyt += dg[fi] * test_feat[i][2];
-      ddyt += ddg[fi] * test_feat[i][2];
-    }
-    const float edge = std::fabs(std::sqrt(dxr * dxr + dyr * dyr) - std::sqrt(dxt * dxt + dyt * dyt));
-    const float point = std::fabs(std::sqrt(ddxr * ddxr + ddyr * ddyr) - std::sqrt(ddxt * ddxt + ddyt * ddyt));
+  parallel_pixels(w, h, [&](int x, int y) {
+    const Four r = feature_column(ref_feat, w, h, ff, x, y), t = feature_column(test_feat, w, h, ff, x, y);
+    const float edge = std::fabs(std::sqrt(r[0] * r[0] + r[2] * r[2]) - std::sqrt(t[0] * t[0] + t[2] * t[2]));
+    const float point = std::fabs(std::sqrt(r[1] * r[1] + r[3] * r[3]) - std::sqrt(t[1] * t[1] + t[3] * t[3]));
     const float feature = std::pow(std::max(edge, point) / std::sqrt(2.0f), kGqf);
     const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
-    out.pixels[i] = std::pow(colour_error[i], 1.0f - feature);
+    out.pixels[i] = std::pow(colour[i], 1.0f - feature);
   });
   return out;
 }

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/hash.h"
 
 namespace raysift::sampling {
 namespace {
@@ -64,11 +65,7 @@ float ray_priority(float p_imp, float p_patt, const PriorityMapping& m) {
 }
 
 std::uint32_t pixel_hash(std::uint32_t pixel, std::uint64_t seed) {
-  // splitmix64 finaliser over (pixel, seed).
-  std::uint64_t z = (std::uint64_t(pixel) << 1 | 1) + seed * 0x9E3779B97F4A7C15ull;
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return std::uint32_t((z ^ (z >> 31)) >> 32);
+  return std::uint32_t(splitmix64_finalize((std::uint64_t(pixel) << 1 | 1) + seed * kSplitmixGamma) >> 32);
 }
 
 ObjectCounts count_object_pixels(const ImageF& importance, const FractalPattern& pattern) {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/hash.h"
 
 namespace raysift::volume {
 
@@ -46,17 +47,9 @@ inline double distance(int i, int j, int k, const Vec3d& c) {
   return length(Vec3d(i - c.x, j - c.y, k - c.z));
 }
 
-/// SplitMix64 finaliser: a well-mixed 64-bit hash, used for seeds (STYLE.md §6: hash(index, seed)).
-std::uint64_t mix64(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ull;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-  return x ^ (x >> 31);
-}
-
 /// Uniform in [0, 1) from (index, seed).
 double hash_uniform(std::uint64_t index, std::uint64_t seed) {
-  return double(mix64(mix64(index) ^ seed) >> 11) * 0x1.0p-53;
+  return unit_double(mix64(mix64(index) ^ seed));
 }
 
 }  // namespace

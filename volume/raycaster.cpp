@@ -17,6 +17,7 @@
 
 #include "core/camera_fit.h"
 #include "core/errors.h"
+#include "core/hash.h"
 #include "core/parallel.h"
 #include "volume/detail/brick_cache.h"
 #include "volume/detail/vdb_grid.h"
@@ -29,14 +30,6 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 /// Growth of each block box in the background test, voxels: far above the rounding of sample positions
 /// (~1e-13 voxels), far below anything visible.
 constexpr double kBlockSlackVoxels = 1e-6;
-
-/// splitmix64 finaliser: a well-mixed 64-bit hash for per-pixel jitter.
-std::uint64_t hash64(std::uint64_t v) {
-  v += 0x9e3779b97f4a7c15ULL;
-  v = (v ^ (v >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  v = (v ^ (v >> 27)) * 0x94d049bb133111ebULL;
-  return v ^ (v >> 31);
-}
 
 /// Ceiling for |x| < 2^62 without a libm call (std::ceil is one without SSE4.1).
 long ceil_long(double x) {
@@ -265,8 +258,8 @@ RaySample RayCaster::Impl::trace(int x, int y) const {
   const double dt = options.step_voxels;
   const double inv_dt = 1.0 / dt;
   const double xi = options.jitter
-                        ? double(hash64(hash64(std::uint64_t(y) * std::uint64_t(camera.width()) + std::uint64_t(x)) ^
-                                        options.seed) >> 11) * 0x1.0p-53
+                        ? unit_double(mix64(mix64(std::uint64_t(y) * std::uint64_t(camera.width()) + std::uint64_t(x)) ^
+                                            options.seed))
                         : 0.5;
   const bool skip = options.skip_empty_space;
   long k = 0;

@@ -1,12 +1,11 @@
 #include "features/detail/distance_transform.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
+
+#include "core/parallel.h"
 
 namespace raysift::features::detail {
 namespace {
@@ -43,17 +42,6 @@ void envelope_1d(const double* f, int n, double* d, std::vector<int>& v, std::ve
   }
 }
 
-template <typename F>
-void for_lines(int n, bool threaded, const F& body) {
-  if (threaded) {
-    tbb::parallel_for(tbb::blocked_range<int>(0, n, 16), [&](const tbb::blocked_range<int>& r) {
-      for (int i = r.begin(); i != r.end(); ++i) body(i);
-    });
-  } else {
-    for (int i = 0; i < n; ++i) body(i);
-  }
-}
-
 }  // namespace
 
 ImageF squared_distance_transform(const Image<std::uint8_t>& seeds, double max_distance, bool threaded) {
@@ -76,21 +64,21 @@ ImageF squared_distance_transform(const Image<std::uint8_t>& seeds, double max_d
   y1 = std::min(h - 1, y1 + pad);
   const int bw = x1 - x0 + 1, bh = y1 - y0 + 1;
   std::vector<double> cols(std::size_t(bw) * std::size_t(bh));
-  for_lines(bw, threaded, [&](int i) {
+  parallel_for_each(bw, [&](int i) {
     const auto n = static_cast<std::size_t>(bh);
     std::vector<double> f(n), d(n), z(n + 1);
     std::vector<int> v(n);
     for (int j = 0; j < bh; ++j) f[std::size_t(j)] = seeds(x0 + i, y0 + j) ? 0.0 : kInf;
     envelope_1d(f.data(), bh, d.data(), v, z);
     for (int j = 0; j < bh; ++j) cols[std::size_t(j) * std::size_t(bw) + std::size_t(i)] = d[std::size_t(j)];
-  });
-  for_lines(bh, threaded, [&](int j) {
+  }, threaded, 16);
+  parallel_for_each(bh, [&](int j) {
     const auto n = static_cast<std::size_t>(bw);
     std::vector<double> d(n), z(n + 1);
     std::vector<int> v(n);
     envelope_1d(cols.data() + std::size_t(j) * n, bw, d.data(), v, z);
     for (int i = 0; i < bw; ++i) out(x0 + i, y0 + j) = float(d[std::size_t(i)]);
-  });
+  }, threaded, 16);
   return out;
 }
 

@@ -7,13 +7,11 @@
 #include <cmath>
 
 #include "core/errors.h"
+#include "core/tolerances.h"
 
 namespace raysift::nrr::detail {
 namespace {
 
-/// Relative shortening of the eye -> sample segment in visibility tests, so that the sample's own
-/// triangle (at parameter 1) is not its own occluder (ALGORITHMS.md §10/§9 choice epsilon_r = 1e-4).
-constexpr float kVisibilitySegmentEpsilon = 1e-4f;
 /// Two peel/visibility candidates closer than this (relative to t) on different triangles are the
 /// same surface point hit on a shared edge; one of them is dropped (ALGORITHMS.md §10).
 constexpr float kSameHitRelative = 1e-6f;
@@ -86,7 +84,7 @@ bool visible_from(const SampledScene& scene, const Camera& camera, const Vec3f& 
   // Back faces do not occlude: the image from `camera` culls them, so they cannot hide x in it.
   mesh::QueryOptions cull;
   cull.cull_back_faces = true;
-  return !scene.rays().occluded({eye, x - eye, 0.0f, 1.0f - kVisibilitySegmentEpsilon}, cull);
+  return !scene.rays().occluded({eye, x - eye, 0.0f, 1.0f - float(tol::kSegmentEndRelative)}, cull);
 }
 
 void trace(const SampledScene& scene, const ImageRule& rule, Span<const mesh::RayF> rays, Span<mesh::Hit> hits,

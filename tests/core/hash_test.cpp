@@ -28,6 +28,13 @@ TEST(Mix64, MatchesPublishedSplitmix64Outputs) {
   EXPECT_EQ(mix64(2 * gamma), 0x06c45d188009454full);
 }
 
+TEST(UnitDouble, CoversZeroToJustBelowOneInStepsOfTwoToTheMinus53) {
+  EXPECT_EQ(unit_double(0), 0.0);
+  EXPECT_EQ(unit_double(std::uint64_t(1) << 11), 0x1.0p-53);  // the low 11 bits are dropped
+  EXPECT_EQ(unit_double((std::uint64_t(1) << 11) - 1), 0.0);
+  EXPECT_EQ(unit_double(~std::uint64_t(0)), 1.0 - 0x1.0p-53);
+}
+
 TEST(Hasher128, AnySplitOfTheInputGivesTheSameDigest) {
   const auto data = test_bytes(1000);
   const Hash128 whole = hash128(data.data(), data.size());

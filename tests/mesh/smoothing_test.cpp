@@ -9,6 +9,7 @@
 #include <cstdint>
 
 #include "core/errors.h"
+#include "core/hash.h"
 #include "mesh/mesh_analysis.h"
 #include "mesh/primitives.h"
 
@@ -17,11 +18,7 @@ namespace {
 
 /// Deterministic noise in [-1, 1] from a vertex index (splitmix64), independent of threads.
 double hash_noise(std::uint64_t i) {
-  std::uint64_t z = i * 0x9E3779B97F4A7C15ull + 0x632BE59BD9B4E019ull;
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  z ^= z >> 31;
-  return double(z >> 11) / double(1ull << 52) - 1.0;
+  return 2.0 * unit_double(splitmix64_finalize(i * kSplitmixGamma + 0x632BE59BD9B4E019ull)) - 1.0;
 }
 
 /// Unit sphere (5120 triangles, edge ~0.06) with radial noise of amplitude 0.02 (RMS ~0.012).

@@ -14,6 +14,29 @@ namespace {
 int floor_div_block(int v) { return v >= 0 ? v >> kBlockLog2 : -((-v + kBlockSize - 1) >> kBlockLog2); }
 
 bool same_value(float a, float b) { return a == b || (std::isnan(a) && std::isnan(b)); }
+
+/// Copies the 9³ voxels of the brick of the block at `origin` into dst, calling add(v) for each. They come from
+/// the block's own leaf and its 7 neighbours towards +x, +y, +z (each a leaf buffer or one constant tile or
+/// background value).
+template <typename Accessor, typename Add>
+void fill_brick(Accessor& acc, const openvdb::Coord& origin, float* dst, const Add& add) {
+  const float* src[8];
+  float tile[8];
+  for (int c = 0; c < 8; ++c) {
+    const openvdb::Coord o = origin.offsetBy((c >> 2) * kBlockSize, (c >> 1 & 1) * kBlockSize, (c & 1) * kBlockSize);
+    const openvdb::FloatTree::LeafNodeType* leaf = acc.probeConstLeaf(o);
+    src[c] = leaf ? leaf->buffer().data() : nullptr;
+    tile[c] = leaf ? 0.0f : acc.getValue(o);
+  }
+  for (int x = 0; x < kBrickSide; ++x)
+    for (int y = 0; y < kBrickSide; ++y)
+      for (int z = 0; z < kBrickSide; ++z) {
+        const int c = (x >> kBlockLog2) << 2 | (y >> kBlockLog2) << 1 | (z >> kBlockLog2);
+        const float v = src[c] ? src[c][((x & 7) << 6) | ((y & 7) << 3) | (z & 7)] : tile[c];
+        dst[(x * kBrickSide + y) * kBrickSide + z] = v;
+        add(v);
+      }
+}
 }  // namespace
 
 VolumeBricks build_volume_bricks_from_grid(const openvdb::FloatGrid& grid) {
@@ -67,8 +90,7 @@ VolumeBricks build_volume_bricks_from_grid(const openvdb::FloatGrid& grid) {
     if (needs[i]) out.brick[i] = bricks++;
   out.values.resize(std::size_t(bricks) * kBrickVoxels);
 
-  // Pass 2: fill bricks and ranges. A brick's 9³ voxels come from the block's own leaf and its 7
-  // neighbours towards +x, +y, +z (each a leaf buffer or one constant tile/background value).
+  // Pass 2: fill bricks and value ranges.
   for_each_block([&](auto& acc, const openvdb::Coord& origin, std::size_t idx) {
     float lo = std::numeric_limits<float>::infinity(), hi = -lo;
     auto add = [&](float v) {
@@ -79,23 +101,7 @@ VolumeBricks build_volume_bricks_from_grid(const openvdb::FloatGrid& grid) {
     if (out.brick[idx] < 0) {
       add(out.constant[idx]);
     } else {
-      const float* src[8];
-      float tile[8];
-      for (int c = 0; c < 8; ++c) {
-        const openvdb::Coord o = origin.offsetBy((c >> 2) * kBlockSize, (c >> 1 & 1) * kBlockSize, (c & 1) * kBlockSize);
-        const Tree::LeafNodeType* leaf = acc.probeConstLeaf(o);
-        src[c] = leaf ? leaf->buffer().data() : nullptr;
-        tile[c] = leaf ? 0.0f : acc.getValue(o);
-      }
-      float* dst = out.values.data() + std::size_t(out.brick[idx]) * kBrickVoxels;
-      for (int x = 0; x < kBrickSide; ++x)
-        for (int y = 0; y < kBrickSide; ++y)
-          for (int z = 0; z < kBrickSide; ++z) {
-            const int c = (x >> kBlockLog2) << 2 | (y >> kBlockLog2) << 1 | (z >> kBlockLog2);
-            const float v = src[c] ? src[c][((x & 7) << 6) | ((y & 7) << 3) | (z & 7)] : tile[c];
-            dst[(x * kBrickSide + y) * kBrickSide + z] = v;
-            add(v);
-          }
+      fill_brick(acc, origin, out.values.data() + std::size_t(out.brick[idx]) * kBrickVoxels, add);
     }
     out.lo[idx] = lo;
     out.hi[idx] = hi;
