@@ -7,6 +7,8 @@
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -251,16 +253,14 @@ bool is_frame_pattern(const std::string& pattern) {
   return count == 1;
 }
 
-std::string frame_file_name(const std::string& pattern, int index) {
+namespace {
+/// `pattern` with its one integer conversion replaced by `text` and each literal "%%" by "%".
+std::string fill_pattern(const std::string& pattern, const std::function<std::string(const std::string& spec)>& text) {
   int count = 0;
   const auto [begin, end] = find_conversion(pattern, count);
   if (count != 1)
     throw InvalidInput("output pattern '" + pattern + "' must hold exactly one integer conversion such as %03d "
                        "(write %% for a literal percent sign)");
-  const std::string spec = pattern.substr(begin, end - begin);
-  char number[64];
-  std::snprintf(number, sizeof number, spec.c_str(), index);
-  // Literal "%%" outside the conversion become "%".
   const auto unescape = [](const std::string& s) {
     std::string out;
     for (std::size_t i = 0; i < s.size(); ++i) {
@@ -269,7 +269,22 @@ std::string frame_file_name(const std::string& pattern, int index) {
     }
     return out;
   };
-  return unescape(pattern.substr(0, begin)) + number + unescape(pattern.substr(end));
+  return unescape(pattern.substr(0, begin)) + text(pattern.substr(begin, end - begin)) + unescape(pattern.substr(end));
+}
+}  // namespace
+
+std::string frame_file_name(const std::string& pattern, int index) {
+  return fill_pattern(pattern, [index](const std::string& spec) {
+    char number[64];
+    std::snprintf(number, sizeof number, spec.c_str(), index);
+    return std::string(number);
+  });
+}
+
+std::string frame_manifest_name(const std::string& pattern) {
+  const std::string name = fill_pattern(pattern, [](const std::string&) { return std::string("manifest"); });
+  const std::string ext = std::filesystem::path(name).extension().string();
+  return name.substr(0, name.size() - ext.size()) + ".json";
 }
 
 ImageF path_frame_importance(const volume::RayCaster& caster, const FeatureGeometry* geometry,
@@ -453,6 +468,11 @@ Json run_path_request(const volume::Volume& volume, const volume::TransferFuncti
     geometry = load_feature_geometry(request.feature_mesh, &volume);
   }
   const double setup_ms = setup.elapsed_ms();
+  // Frames stream out one by one, each atomically; the manifest, written last, marks a complete sequence, so
+  // a stale one from an earlier run must not outlive the first new frame.
+  const std::string manifest = frame_manifest_name(request.out_pattern);
+  std::error_code ec;
+  std::filesystem::remove(manifest, ec);
   const auto frames = render_camera_path(volume, tf, render, cameras, geometry ? &*geometry : nullptr, request.options,
                                          [&](const PathFrame& frame, const ImageRGBA& image) {
                                            const std::string name = frame_file_name(request.out_pattern, frame.index);
@@ -466,6 +486,10 @@ Json run_path_request(const volume::Volume& volume, const volume::TransferFuncti
   stats["frame_files"] = {frame_file_name(request.out_pattern, 0),
                           frame_file_name(request.out_pattern, int(frames.size()) - 1)};
   stats["times_ms"] = {{"features_setup", setup_ms}, {"total", total.elapsed_ms()}};
+  Json files = Json::array();
+  for (const PathFrame& f : frames) files.push_back(frame_file_name(request.out_pattern, f.index));
+  write_json_file(manifest, {{"camera_path", request.camera_path}, {"frames", frames.size()}, {"files", files}});
+  stats["manifest"] = manifest;
   return stats;
 }
 

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "apps/raysift/command.h"
+#include "apps/raysift/guard_flags.h"
 #include "core/errors.h"
 #include "core/timer.h"
 #include "volume/import.h"
@@ -43,6 +44,7 @@ RegisterCommand reg(
       sub.add_option("--tolerance", opt->tolerance, "|v - background| <= tolerance stays inactive")
           ->capture_default_str();
       sub.add_flag("--half", opt->half, "store values as 16-bit floats on disk (about half the file size)");
+      add_max_memory_flag(sub, common);
       sub.footer(
           "Examples:\n"
           "  raysift import engine.raw.gz --dims 256,256,128 --type u8 -o engine.vdb\n"
@@ -69,6 +71,8 @@ RegisterCommand reg(
         options.grid_name = opt->grid;
         options.background = opt->background;
         options.tolerance = opt->tolerance;
+        const MemoryLimit limit = memory_limit(common);
+        options.memory_limit = &limit;
 
         Timer timer;
         volume::Volume vol;

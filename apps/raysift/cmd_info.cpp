@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "apps/raysift/command.h"
+#include "apps/raysift/guard_flags.h"
 #include "core/errors.h"
 #include "core/scene.h"
 #include "core/timer.h"
@@ -76,6 +77,7 @@ RegisterCommand reg("info", "describe the grids of a .vdb file (bbox, voxel size
                       sub.add_option("--bins", opt->bins, "histogram bins")->capture_default_str();
                       sub.footer("Examples:\n  raysift info datasets/engine_ct.vdb\n"
                                  "  raysift info smoke.vdb --grid density --stats smoke_info.json");
+                      add_non_finite_flag(sub, common);
                       return [opt, &common] {
                         if (opt->bins < 1) bad_flag("--bins", ">= 1", std::to_string(opt->bins));
                         std::string path = opt->volume, grid = opt->grid;
@@ -103,7 +105,8 @@ RegisterCommand reg("info", "describe the grids of a .vdb file (bbox, voxel size
                         std::string hist_grid;
                         timer.reset();
                         if (!grid.empty()) {
-                          const volume::Volume vol = volume::load_vdb(path, grid, volume::EmptyGrid::Allow);
+                          const volume::Volume vol = volume::load_vdb(
+                              path, grid, {volume::EmptyGrid::Allow, non_finite_policy(common)});
                           hist = volume::compute_histogram(vol, opt->bins);
                           hist_grid = vol.name();
                           stats["histogram"] = {{"grid", hist_grid}, {"min", hist.min}, {"max", hist.max},

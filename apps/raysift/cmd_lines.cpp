@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "apps/raysift/command.h"
+#include "core/output_set.h"
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/image.h"
@@ -221,9 +222,12 @@ RegisterCommand reg(
         }
         const double raster_ms = timer.elapsed_ms();
 
-        write_image(opt->out, picture);
-        if (!opt->svg.empty()) features::write_lines_svg(opt->svg, visible, cam, opt->picture.line_width_px);
-        if (importance) write_image(opt->importance, importance->values);
+        OutputSet outputs;  // picture, SVG and importance appear together or not at all
+        write_image(outputs.stage(opt->out), picture);
+        if (!opt->svg.empty())
+          features::write_lines_svg(outputs.stage(opt->svg), visible, cam, opt->picture.line_width_px);
+        if (importance) write_image(outputs.stage(opt->importance), importance->values);
+        outputs.commit();
 
         Json segments = Json::object();
         for (int c = 0; c < features::kLineClassCount; ++c)

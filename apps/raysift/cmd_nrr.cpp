@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "apps/raysift/command.h"
+#include "core/output_set.h"
 #include "core/errors.h"
 #include "core/timer.h"
 #include "mesh/mesh_io.h"
@@ -202,12 +203,15 @@ RegisterCommand reg(
 
         if (!o.out_dir.empty()) {
           const std::filesystem::path dir(o.out_dir);
-          std::filesystem::create_directories(dir);  // only now: a failed run leaves no folder behind
+          OutputSet outputs;  // every image or none, and no folder left behind by a failed run
+          outputs.make_directories(dir.string());
           for (std::size_t i = 0; i < images.size(); ++i) {
             const std::string stem = (dir / ("image_" + std::to_string(i))).string();
-            nrr::write_depth_image(images[i], stem + ".exr", stem + ".png");
-            if (!o.skip_metrics) write_image(stem + "_samples.png", nrr::sample_class_image(images[i], m.sample_classes[i]));
+            nrr::write_depth_image(images[i], outputs.stage(stem + ".exr"), outputs.stage(stem + ".png"));
+            if (!o.skip_metrics)
+              write_image(outputs.stage(stem + "_samples.png"), nrr::sample_class_image(images[i], m.sample_classes[i]));
           }
+          outputs.commit();
         }
         if (!common.quiet) {
           std::printf("raysift nrr: %s, %zu images of %dx%d, render %.1f ms, metrics %.1f ms\n", o.mode.c_str(),

@@ -9,11 +9,14 @@
 #include <sstream>
 
 #include "apps/raysift/command.h"
+#include "apps/raysift/guard_flags.h"
 #include "apps/raysift/sampling_flags.h"
 #include "apps/raysift/volume_input.h"
 #include "core/file_util.h"
 #include "core/image.h"
+#include "core/memory_limit.h"
 #include "core/progress.h"
+#include "core/signals.h"
 #include "core/scene.h"
 #include "core/timer.h"
 #include "sampling/camera_path.h"
@@ -87,7 +90,10 @@ const std::map<std::string, ModeFunction>& modes() {
       {"full",
        [](const RenderInputs&, const volume::RayCaster& caster, const CommonOptions& common) {
          ProgressBar bar("render", !common.quiet);
-         volume::RenderResult r = volume::render_full(caster, [&bar](double f) { bar.update(f); });
+         volume::RenderResult r = volume::render_full(caster, [&bar](double f) {
+           throw_if_cancelled();  // unwinds out of the TBB tiles; nothing has been written yet
+           bar.update(f);
+         });
          return ModeOutput{std::move(r.image), r.rays_traced, r.samples, Json::object()};
        }},
       {"prioritized", sampled_mode},
@@ -160,8 +166,18 @@ void validate(const RenderCliOptions& o) {
     throw UsageError("--budget-ms and --progressive need --mode prioritized; see --help");
 }
 
+/// The image buffers of one render. The sampled modes keep an importance map, the traced samples, their masks
+/// and a composited copy beside the frame; progressive rendering adds its sample accumulator. Counted as
+/// multiples of the full render's colour+depth buffers (20 bytes per pixel).
+std::uint64_t render_bytes(const RenderCliOptions& o, const CameraSpec& camera) {
+  const std::uint64_t frame = volume::render_full_bytes(camera.width, camera.height);
+  if (o.mode == "full") return frame;
+  return frame * (o.progressive > 0 ? 5 : 4);
+}
+
 RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common) {
-  VolumeInput input = load_volume_input(o.volume, o.grid, o.tf, o.tf_normalized, common.scene_path, "render");
+  VolumeInput input = load_volume_input(o.volume, o.grid, o.tf, o.tf_normalized, common, "render",
+                                        volume::EmptyGrid::Allow);
   if (!input.tf) throw UsageError("render needs --tf TF.json or a --scene with a 'transfer_function'; see --help");
   const Scene& scene = input.scene;
   const volume::GridInfo& info = input.info;
@@ -192,6 +208,9 @@ RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common
   } else {
     in.camera = volume::fit_camera(in.volume, width, height);
   }
+  require_memory(render_bytes(o, in.camera), memory_limit(common), SizeSource::Flag,
+                 "a " + std::to_string(in.camera.width) + "x" + std::to_string(in.camera.height) + " " + o.mode +
+                     " render");
 
   in.options.step_voxels = o.step;
   in.options.shading = o.shading == "phong" ? volume::Shading::Phong : volume::Shading::None;
@@ -353,6 +372,8 @@ RegisterCommand reg(
           "  raysift render --scene datasets/engine_ct_scene.json --mode prioritized --ray-fraction 0.2 -o p.exr\n"
           "  raysift render --scene datasets/engine_ct_scene.json --mode subsample --ray-fraction 0.2 -o s.exr");
       auto path = std::make_shared<PathCliOptions>();
+      add_non_finite_flag(sub, common);
+      add_max_memory_flag(sub, common);
       sub.add_option("--camera-path", path->camera_path,
                      "render a sequence: JSON list of cameras, {\"cameras\": [...]} or {\"orbit\": {centre, radius, "
                      "elevation_deg, frames}}; -o is then a pattern such as frame_%03d.png; --features may add saliency");

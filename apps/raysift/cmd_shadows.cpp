@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "apps/raysift/command.h"
+#include "core/output_set.h"
 #include "core/file_util.h"
 #include "core/image.h"
 #include "core/scene.h"
@@ -201,13 +202,15 @@ RegisterCommand reg(
         const nrr::ShadowErrors errors = nrr::compute_shadow_errors(result.visibility, ref_vis, hit);
 
         const ImageF fraction = nrr::visible_fraction(result.visibility, receivers.width, receivers.height, hit);
+        OutputSet outputs;  // the image and the error map appear together or not at all
         if (out_ext == ".exr") {
-          write_image(opt->out, fraction);
+          write_image(outputs.stage(opt->out), fraction);
         } else {
-          write_image(opt->out, shade(receivers, fraction, light));
+          write_image(outputs.stage(opt->out), shade(receivers, fraction, light));
         }
         if (!opt->error_map.empty())
-          write_image(opt->error_map, nrr::error_map_image(errors, receivers.width, receivers.height));
+          write_image(outputs.stage(opt->error_map), nrr::error_map_image(errors, receivers.width, receivers.height));
+        outputs.commit();
 
         Json stats = errors_json(errors);
         stats["method"] = opt->method;

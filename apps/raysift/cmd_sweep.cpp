@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "apps/raysift/command.h"
+#include "apps/raysift/guard_flags.h"
 #include "apps/raysift/sampling_flags.h"
 #include "apps/raysift/run_program.h"
 #include "core/file_util.h"
@@ -105,6 +106,7 @@ RegisterCommand reg(
       sub.footer(
           "Example:\n  raysift sweep datasets/engine_ct_scene.json --ray-fractions 0.1,0.2,0.4,0.7 -o trade.csv "
           "--plot trade.png");
+      add_non_finite_flag(sub, common);
       return [opt, &common] {
         const std::vector<double> fractions =
             parse_list("--ray-fractions", opt->fractions, "comma-separated fractions in (0, 1]", is_fraction);
@@ -134,7 +136,8 @@ RegisterCommand reg(
         if (scene.volume.empty()) throw InvalidInput(file_message(opt->scene, "the scene has no 'volume'"));
         if (scene.transfer_function.is_null())
           throw InvalidInput(file_message(opt->scene, "the scene has no 'transfer_function'"));
-        const volume::Volume vol = volume::load_vdb(scene.volume, scene.grid);
+        const volume::Volume vol =
+            volume::load_vdb(scene.volume, scene.grid, {volume::EmptyGrid::Reject, non_finite_policy(common)});
         const volume::TransferFunction tf =
             volume::transfer_function_from_json(scene.transfer_function, scene.transfer_function_source);
         CameraSpec camera = scene.camera ? *scene.camera : volume::fit_camera(vol, 1440, 900);
