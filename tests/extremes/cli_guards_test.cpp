@@ -53,6 +53,25 @@ TEST(MemoryLimits, IssueExamplesFailBeforeWork) {
   for (const char* f : {"big.exr", "huge.vdb", "ball.ply", "cube.vdb", "x.exr"}) EXPECT_FALSE(fs::exists(dir + "/" + f)) << f;
 }
 
+TEST(CameraPathOutputs, FramesThenManifestLast) {
+  // Frames stream out (each atomically); the manifest, written after the last one, lists them. The stale
+  // manifest planted here is replaced (it is removed before the first frame, so an interrupted run cannot
+  // leave one that claims completeness).
+  const std::string dir = test::make_temp_dir("path_manifest");
+  ASSERT_EQ(raysift(dir, "make-volume ball --dims 24,24,24 --radius 8 -o ball.vdb --quiet").code, 0);
+  write_bytes(dir + "/tf.json", R"({"points": [[0, 0, 0, 0, 0], [1, 1, 1, 1, 0.5]]})");
+  write_bytes(dir + "/orbit.json", R"({"orbit": {"centre": [11.5, 11.5, 11.5], "radius": 60, "elevation_deg": 20,
+      "up": [0, 1, 0], "fov_y_deg": 30, "width": 32, "height": 24, "frames": 3}})");
+  write_bytes(dir + "/f_manifest.json", R"({"frames": 99})");
+  const CliRun ok = raysift(dir, "render ball.vdb --tf tf.json --camera-path orbit.json -o f_%02d.png --quiet");
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  const Json manifest = read_json_file(dir + "/f_manifest.json");
+  EXPECT_EQ(manifest["frames"], 3);
+  EXPECT_EQ(manifest["files"], Json::parse(R"(["f_00.png", "f_01.png", "f_02.png"])"));
+  for (const char* f : {"f_00.png", "f_01.png", "f_02.png"}) EXPECT_TRUE(fs::exists(dir + "/" + f)) << f;
+
+}
+
 TEST(NrrdOrientation, InfoShowsTheHandComputedWorldBox) {
   // world = (10,-5,3) + i*(0,0.3,0.4) + j*(2,0,0) + k*(0,-0.8,0.6) over i in {0,1}, j in {0,2}, k in {0,1}.
   const std::string dir = test::make_temp_dir("nrrd_info");

@@ -3,6 +3,7 @@
 // image at step 1e-3 would take minutes), and the signal is sent only once it has printed its effective
 // command line (-v), i.e. after the handlers are installed and the volume is loaded.
 #include <gtest/gtest.h>
+#include <poll.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -52,13 +53,16 @@ Interrupted interrupt_run(const std::string& dir, const std::vector<std::string>
   if (spawned != 0) return result;
   char c = 0;
   bool signalled = false;
-  while (read(pipe_fds[0], &c, 1) == 1) {
+  pollfd readable{pipe_fds[0], POLLIN, 0};
+  // A render that ignored the signal would run for minutes: after 60 s of silence it is killed (exit -9).
+  while (poll(&readable, 1, 60000) == 1 && read(pipe_fds[0], &c, 1) == 1) {
     result.err += c;
     if (c == '\n' && !signalled) {
       kill(pid, signo);
       signalled = true;
     }
   }
+  kill(pid, SIGKILL);  // no-op once it has exited (it is a zombie until waitpid)
   close(pipe_fds[0]);
   int status = 0;
   waitpid(pid, &status, 0);
