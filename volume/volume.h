@@ -36,7 +36,7 @@ struct DenseSpec {
   /// If set, axes_ws[a] is the world step of index axis a (rotation, shear and flips allowed; voxel_size is
   /// then ignored): world = origin_ws + i*axes_ws[0] + j*axes_ws[1] + k*axes_ws[2]. The axes must be
   /// linearly independent.
-  std::optional<std::array<Vec3d, 3>> axes_ws;
+  std::optional<std::array<Vec3d, 3>> axes_ws = std::nullopt;
   float background = 0.0f;
   float tolerance = 0.0f;      ///< |v - background| <= tolerance stays inactive
 };

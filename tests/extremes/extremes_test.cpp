@@ -99,7 +99,9 @@ std::string Extremes::dir_;
 /// Every number in the stats JSON is finite; a null is a NaN or Inf that nlohmann::json could not write.
 void expect_finite_json(const Json& j, const std::string& where) {
   if (j.is_null()) ADD_FAILURE() << where << " is null (NaN/Inf)";
-  if (j.is_number_float()) EXPECT_TRUE(std::isfinite(j.get<double>())) << where << " = " << j;
+  if (j.is_number_float()) {
+    EXPECT_TRUE(std::isfinite(j.get<double>())) << where << " = " << j;
+  }
   if (j.is_object())
     for (const auto& [key, value] : j.items()) expect_finite_json(value, where + "." + key);
   if (j.is_array())
@@ -116,7 +118,9 @@ void expect_finite_image(const std::string& path) {
 void expect_finite_mesh(const std::string& path) {
   const TriMesh m = mesh::read_mesh(path);  // refuses non-finite positions itself; checked again here
   ASSERT_GT(m.triangle_count(), 0u) << path;
-  for (const Vec3f& p : m.positions) ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) << path;
+  for (const Vec3f& p : m.positions) {
+    ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) << path;
+  }
 }
 
 struct Case {
@@ -198,7 +202,7 @@ INSTANTIATE_TEST_SUITE_P(
 
 TEST_F(Extremes, NonFiniteVoxelsAreRefusedByDefaultWithOneLine) {
   for (const char* file : {"nan.vdb", "inf.vdb"}) {
-    for (const std::string command : {"render " + std::string(file) + " --tf tf.json -o x.exr",
+    for (const std::string& command : {"render " + std::string(file) + " --tf tf.json -o x.exr",
                                       "mesh " + std::string(file) + " --iso 0.5 -o x.ply"}) {
       const CliRun run = raysift(command, "refuse");
       EXPECT_EQ(run.code, 1) << command;
