@@ -26,6 +26,11 @@ struct SolverError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A stage would need more memory than the limit allows (core/memory_limit.h); checked before allocating.
+struct ResourceError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 /// The caller asked a long stage to stop (its cancel flag was set); nothing was produced.
 struct Cancelled : std::runtime_error {
   using std::runtime_error::runtime_error;

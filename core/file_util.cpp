@@ -1,13 +1,13 @@
 #include "core/file_util.h"
 
 #include <algorithm>
-#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <unistd.h>
 
 #include "core/errors.h"
+#include "core/output_set.h"
+#include "core/signals.h"
 
 namespace fs = std::filesystem;
 
@@ -37,19 +37,12 @@ std::string read_file_bytes(const std::string& path) {
 }
 
 void write_atomically(const std::string& path, const std::function<void(const std::string&)>& write) {
-  static std::atomic<unsigned> counter{0};
-  const fs::path target(path);
+  const std::string tmp = temporary_sibling(path);
   std::error_code ec;
-  if (target.filename().empty() || fs::is_directory(target, ec))
-    throw IoError(file_message(path, "is a directory, expected an output file name"));
-  const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  if (!fs::is_directory(parent, ec))
-    throw IoError(file_message(path, "output folder '" + parent.string() + "' does not exist"));
-  const fs::path tmp = parent / ("." + target.stem().string() + ".tmp" + std::to_string(::getpid()) + "_" +
-                                 std::to_string(counter++) + target.extension().string());
   try {
-    write(tmp.string());
-    fs::rename(tmp, target, ec);
+    write(tmp);
+    throw_if_cancelled();  // a command stopped by a signal moves nothing into place
+    fs::rename(tmp, path, ec);
     if (ec) throw IoError(file_message(path, "cannot move finished output into place: " + ec.message()));
   } catch (...) {
     fs::remove(tmp, ec);

@@ -8,7 +8,8 @@ namespace raysift {
 
 /// Calls `write(tmp_path)` where tmp_path keeps the target's extension (format detection), then
 /// renames it to `path`. On any exception the temporary file is removed and the exception rethrown.
-/// \throw IoError if `path` is a directory, its parent folder does not exist, or the rename fails.
+/// For several files that must appear together use OutputSet (core/output_set.h).
+/// \throw Cancelled if a SIGINT/SIGTERM arrived before the rename (core/signals.h); IoError if `path` is a directory, its parent folder does not exist, or the rename fails.
 void write_atomically(const std::string& path, const std::function<void(const std::string& tmp_path)>& write);
 
 /// \throw IoError naming the file if it is missing, a directory or unreadable.

@@ -4,6 +4,8 @@
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -232,16 +234,14 @@ bool is_frame_pattern(const std::string& pattern) {
   return count == 1;
 }
 
-std::string frame_file_name(const std::string& pattern, int index) {
+namespace {
+/// `pattern` with its one integer conversion replaced by `text` and each literal "%%" by "%".
+std::string fill_pattern(const std::string& pattern, const std::function<std::string(const std::string& spec)>& text) {
   int count = 0;
   const auto [begin, end] = find_conversion(pattern, count);
   if (count != 1)
     throw InvalidInput("output pattern '" + pattern + "' must hold exactly one integer conversion such as %03d "
                        "(write %% for a literal percent sign)");
-  const std::string spec = pattern.substr(begin, end - begin);
-  char number[64];
-  std::snprintf(number, sizeof number, spec.c_str(), index);
-  // Literal "%%" outside the conversion become "%".
   const auto unescape = [](const std::string& s) {
     std::string out;
     for (std::size_t i = 0; i < s.size(); ++i) {
@@ -250,7 +250,22 @@ std::string frame_file_name(const std::string& pattern, int index) {
     }
     return out;
   };
-  return unescape(pattern.substr(0, begin)) + number + unescape(pattern.substr(end));
+  return unescape(pattern.substr(0, begin)) + text(pattern.substr(begin, end - begin)) + unescape(pattern.substr(end));
+}
+}  // namespace
+
+std::string frame_file_name(const std::string& pattern, int index) {
+  return fill_pattern(pattern, [index](const std::string& spec) {
+    char number[64];
+    std::snprintf(number, sizeof number, spec.c_str(), index);
+    return std::string(number);
+  });
+}
+
+std::string frame_manifest_name(const std::string& pattern) {
+  const std::string name = fill_pattern(pattern, [](const std::string&) { return std::string("manifest"); });
+  const std::string ext = std::filesystem::path(name).extension().string();
+  return name.substr(0, name.size() - ext.size()) + ".json";
 }
 
 ImageF path_frame_importance(const volume::RayCaster& caster, const FeatureGeometry* geometry,

@@ -56,6 +56,10 @@ bool is_frame_pattern(const std::string& pattern);
 /// The file name of frame `index`: `pattern` formatted with it.
 /// \throw InvalidInput unless is_frame_pattern(pattern).
 std::string frame_file_name(const std::string& pattern, int index);
+/// The manifest written after the last frame: the pattern with its conversion replaced by "manifest" and the
+/// extension by ".json" (frame_%03d.png -> frame_manifest.json). It lists the frame files; a sequence without
+/// it is incomplete (interrupted or failed). \throw InvalidInput unless is_frame_pattern(pattern).
+std::string frame_manifest_name(const std::string& pattern);
 
 /// The previous frame as the next one needs it for the saliency warp.
 struct PreviousFrame {

@@ -3,6 +3,7 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstring>
@@ -112,6 +113,7 @@ struct Geometry {
   Vec3i dims;
   Vec3d spacing{1, 1, 1};
   Vec3d origin{0, 0, 0};
+  std::optional<std::array<Vec3d, 3>> axes;  ///< NRRD space directions: world step of each index axis
 };
 
 void validate_options(const std::string& path, const ImportOptions& o) {
@@ -162,6 +164,13 @@ Volume build_volume(const std::string& path, const unsigned char* data, ScalarTy
   spec.dims = geo.dims;
   spec.voxel_size = options.spacing ? *options.spacing : geo.spacing;
   spec.origin_ws = geo.origin;
+  if (geo.axes) {
+    spec.axes_ws = geo.axes;
+    // --spacing keeps the NRRD's directions and replaces their lengths.
+    if (options.spacing)
+      for (int a = 0; a < 3; ++a)
+        (*spec.axes_ws)[std::size_t(a)] = normalize((*geo.axes)[std::size_t(a)]) * (*options.spacing)[a];
+  }
   spec.background = options.background;
   spec.tolerance = options.tolerance;
   return Volume::from_function(
@@ -170,6 +179,16 @@ Volume build_volume(const std::string& path, const unsigned char* data, ScalarTy
         return decode(data + (std::size_t(i) + nx * std::size_t(j) + nxy * std::size_t(k)) * stride, type, swap);
       },
       options.grid_name);
+}
+
+/// Memory of the import: the dense data (`dense` bytes, plus `extra` already held, e.g. compressed input) and
+/// the grid it becomes when every voxel is active.
+void check_import_memory(const std::string& path, const ImportOptions& options, std::uint64_t dense,
+                         ScalarType type, std::uint64_t extra) {
+  if (!options.memory_limit) return;
+  const std::uint64_t voxels = dense / std::uint64_t(type_entry(type).bytes);
+  require_memory(saturating_product(1, dense + extra) + grid_bytes_upper_bound(voxels), *options.memory_limit,
+                 SizeSource::Input, file_message(path, "importing " + std::to_string(voxels) + " voxels"));
 }
 
 [[noreturn]] void size_mismatch(const std::string& path, std::uint64_t expected, std::uint64_t actual,
@@ -220,6 +239,8 @@ Volume import_raw(const std::string& path, const RawLayout& layout, const Import
   Geometry geo;
   geo.dims = layout.dims;
   if (ends_with(lower(path), ".gz")) {
+    std::error_code size_ec;
+    check_import_memory(path, options, expected, layout.type, std::filesystem::file_size(path, size_ec));
     const std::string packed = read_file_bytes(path);
     const Inflated raw = gunzip(path, packed.data(), packed.size(), expected);
     if (raw.total != expected) size_mismatch(path, expected, raw.total, layout.dims, layout.type, " after gunzip");
@@ -231,6 +252,7 @@ Volume import_raw(const std::string& path, const RawLayout& layout, const Import
   const std::uint64_t actual = std::filesystem::file_size(path, ec);
   if (ec) throw IoError(file_message(path, "cannot get file size: " + ec.message()));
   if (actual != expected) size_mismatch(path, expected, actual, layout.dims, layout.type, "");
+  check_import_memory(path, options, expected, layout.type, 0);
   const std::string raw = read_file_bytes(path);
   return build_volume(path, reinterpret_cast<const unsigned char*>(raw.data()), layout.type, layout.endian, geo,
                       options);
@@ -384,6 +406,10 @@ class NrrdParser {
       if (h_.directions.size() != 3) fail("space directions needs 3 vectors, got '" + value + "'");
       for (const Vec3d& d : h_.directions)
         if (!(length(d) > 0)) fail("space directions must be non-zero vectors, got '" + value + "'");
+      const std::vector<Vec3d>& d = h_.directions;
+      // Relative to the lengths, so tiny (micrometre) and huge voxels are judged alike.
+      if (!(std::abs(dot(d[0], cross(d[1], d[2]))) > 1e-9 * length(d[0]) * length(d[1]) * length(d[2])))
+        fail("space directions must be linearly independent, got '" + value + "'");
     } else if (name == "space origin") {
       h_.origin = vector(value, "space origin");
     } else if (name == "data file" || name == "datafile") {
@@ -480,11 +506,17 @@ Volume import_nrrd(const std::string& path, const ImportOptions& options) {
   if (h.spacings) {
     geo.spacing = *h.spacings;
   } else if (!h.directions.empty()) {
+    // World = space origin + directions * index in the NRRD's own space (no RAS/LPS conversion).
     geo.spacing = {length(h.directions[0]), length(h.directions[1]), length(h.directions[2])};
+    geo.axes = std::array<Vec3d, 3>{h.directions[0], h.directions[1], h.directions[2]};
   }
   if (h.origin) geo.origin = *h.origin;
   const ScalarType type = *h.type;
   const std::uint64_t expected = dense_bytes(path, geo.dims, type);
+  // ascii data is parsed into doubles (8 bytes per voxel) before the grid is built.
+  check_import_memory(path, options, h.encoding == "ascii" ? expected / std::uint64_t(scalar_type_bytes(type)) * 8
+                                                           : expected,
+                      h.encoding == "ascii" ? ScalarType::F64 : type, text.size());
 
   std::string detached;
   std::string data_path = path;

@@ -556,6 +556,11 @@ TriMesh extract(const openvdb::FloatGrid& grid, const BlockSet& blocks, double i
   float iso_f = float(iso);
   if (double(iso_f) < iso) iso_f = std::nextafter(iso_f, std::numeric_limits<float>::infinity());
   const std::size_t n = blocks.size();
+  if (options.memory_limit)
+    require_memory(saturating_product(n + 1, sizeof(InsideMask) + sizeof(OwnedEdges) + sizeof(MeshCounts) + 1 +
+                                                 2 * sizeof(std::uint64_t)),
+                   *options.memory_limit, SizeSource::Input,
+                   "marching cubes over " + std::to_string(n) + " blocks (working buffers)");
   IsoContext ctx{blocks, grid.background(), iso, iso_f, case_corners(false), {}, {}, {}, {}, {}, {}};
   ctx.masks.reset(new InsideMask[n + 1]);
   ctx.state.reset(new std::uint8_t[n + 1]);
@@ -577,6 +582,11 @@ TriMesh extract(const openvdb::FloatGrid& grid, const BlockSet& blocks, double i
     ctx.triangle_offset[b + 1] = ctx.triangle_offset[b] + ctx.counts[b].triangles;
   }
   if (ctx.vertex_offset[n] > UINT32_MAX) throw InvalidInput("marching cubes: more than 2^32 vertices");
+  if (options.memory_limit)
+    require_memory(ctx.vertex_offset[n] * sizeof(Vec3f) + ctx.triangle_offset[n] * sizeof(std::array<std::uint32_t, 3>),
+                   *options.memory_limit, SizeSource::Input,
+                   "the iso-surface at " + std::to_string(iso) + " (" + std::to_string(ctx.triangle_offset[n]) +
+                       " triangles)");
   TriMesh mesh;
   // The zero-filling (and first-touch page faults) of the two arrays costs as much as a pass: overlap them.
   auto size_positions = [&] { mesh.positions.resize(ctx.vertex_offset[n]); };
@@ -588,7 +598,9 @@ TriMesh extract(const openvdb::FloatGrid& grid, const BlockSet& blocks, double i
     size_triangles();
   }
   const IndexToWorld to_world(grid.transform());
-  const CaseTable& corners = case_corners(options.flip_orientation);
+  // A mirroring transform (a NRRD flip) reverses every triangle's world orientation: undo it here.
+  const bool mirrored = grid.transform().isLinear() && grid.transform().baseMap()->getAffineMap()->getMat4().det() < 0;
+  const CaseTable& corners = case_corners(options.flip_orientation != mirrored);
   if (!for_each_block(n, options, progress_begin + 0.5 * span, progress_end, [&](std::size_t b) {
         fill_block(ctx, b, to_world, corners, mesh);
       }))

@@ -8,6 +8,7 @@
 /// every cut grid edge yields exactly one shared vertex (watertight, consistently oriented).
 #include <vector>
 
+#include "core/memory_limit.h"
 #include "core/span.h"
 #include "core/tri_mesh.h"
 #include "volume/volume.h"
@@ -28,6 +29,9 @@ struct MarchingCubesOptions {
   /// Called with the finished fraction of the whole call in (0, 1], from worker threads (must be thread-safe),
   /// once per chunk of 64 blocks and pass. Empty = no reports.
   std::function<void(double fraction)> progress;
+  /// If set, the per-block working buffers and then (after the counting pass, before any output array exists)
+  /// the mesh itself are checked against it: ResourceError naming the bytes. Null = no check.
+  const MemoryLimit* memory_limit = nullptr;
 };
 
 /// Extracts the iso-surface {f = iso} with the inside predicate f >= iso (strict on one side). Vertices sit
@@ -37,7 +41,8 @@ struct MarchingCubesOptions {
 /// Positions are in world space (the grid's index-to-world transform). A closed surface comes out as a
 /// closed, consistently oriented 2-manifold. NaN voxels count as outside.
 /// \param iso the iso-value, finite. An iso-value outside the data range yields an empty mesh.
-/// \throw InvalidInput if iso is not finite or the volume has no active voxels.
+/// \throw InvalidInput if iso is not finite or the volume has no active voxels; ResourceError (see
+///        MarchingCubesOptions::memory_limit).
 TriMesh extract_isosurface(const Volume& volume, double iso, const MarchingCubesOptions& options = {});
 
 /// One surface per iso-value, in the given order; each is extracted on its own (separate meshes).

@@ -644,6 +644,10 @@ CameraSpec fit_camera(const Volume& volume, int width, int height) {
   return fit_camera_to_box(box, width, height);
 }
 
+std::uint64_t render_full_bytes(int width, int height) {
+  return std::uint64_t(std::max(width, 0)) * std::uint64_t(std::max(height, 0)) * (sizeof(Rgba) + sizeof(float));
+}
+
 RenderResult render_full(const RayCaster& caster, const ProgressCallback& progress, bool threaded) {
   constexpr int kTile = 32;
   const int w = caster.width(), h = caster.height();

@@ -139,6 +139,10 @@ CameraSpec fit_camera(const Volume& volume, int width, int height);
 /// Called with the finished fraction in [0,1], from worker threads (must be thread-safe).
 using ProgressCallback = std::function<void(double fraction)>;
 
+/// Bytes render_full() allocates for a width×height frame (colour and depth per pixel). The caster's own tables
+/// grow with the volume, not the image, and are not counted.
+std::uint64_t render_full_bytes(int width, int height);
+
 /// Traces every pixel in 32×32 tiles with TBB; the image is identical for any thread count.
 /// `threaded = false` runs serially (for debugging).
 RenderResult render_full(const RayCaster& caster, const ProgressCallback& progress = {}, bool threaded = true);

@@ -18,9 +18,7 @@ std::string point_text(std::size_t i) { return "point " + std::to_string(i); }
 
 void validate_points(const std::vector<TfPoint>& points, const std::string& source) {
   const std::string prefix = source.empty() ? "transfer function" : source;
-  if (points.size() < 2)
-    throw InvalidInput(prefix + ": a transfer function needs at least two points, got " +
-                       std::to_string(points.size()));
+  if (points.empty()) throw InvalidInput(prefix + ": a transfer function needs at least one point, got none");
   for (std::size_t i = 0; i < points.size(); ++i) {
     const TfPoint& p = points[i];
     if (!std::isfinite(p.x)) throw InvalidInput(prefix + ": " + point_text(i) + " has a non-finite value x");
@@ -188,6 +186,11 @@ TransferFunction from_plain(const Json& j, const std::string& source, const TfJs
 
 TransferFunction::TransferFunction(std::vector<TfPoint> points) : points_(std::move(points)) {
   validate_points(points_, "");
+  if (points_.size() == 1) {  // a constant TF: the same point again, far enough right to stay distinct in double
+    TfPoint twin = points_.front();
+    twin.x += std::max(1.0, std::abs(twin.x));
+    points_.push_back(twin);
+  }
 }
 
 Rgba TransferFunction::evaluate(double value) const {

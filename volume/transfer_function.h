@@ -18,7 +18,8 @@ struct TfPoint {
 
 class TransferFunction {
  public:
-  /// \throw InvalidInput for fewer than two points, x not strictly increasing, NaN/Inf,
+  /// One point gives a constant TF (stored as two equal points, the second at x + max(1, |x|)).
+  /// \throw InvalidInput for no points, x not strictly increasing, NaN/Inf,
   ///        colour or opacity outside [0,1].
   explicit TransferFunction(std::vector<TfPoint> points);
 

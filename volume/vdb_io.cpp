@@ -6,7 +6,10 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <limits>
 #include <new>
 #include <sstream>
 
@@ -52,27 +55,76 @@ std::string describe_grids(const openvdb::GridPtrVec& grids) {
   return s;
 }
 
-/// Voxels (and tile values) that are NaN or Inf; leaves in parallel, integer count.
-std::uint64_t count_non_finite(const openvdb::FloatGrid& grid) {
-  using Tree = openvdb::FloatTree;
+using Tree = openvdb::FloatTree;
+
+/// Smallest and largest finite active value (leaves in parallel, then tiles); lo > hi if there is none.
+std::pair<float, float> finite_range(const openvdb::FloatGrid& grid) {
+  using Range = std::pair<float, float>;
+  auto merge = [](Range a, Range b) { return Range{std::min(a.first, b.first), std::max(a.second, b.second)}; };
+  const Range none{std::numeric_limits<float>::max(), std::numeric_limits<float>::lowest()};
   openvdb::tree::LeafManager<const Tree> leaves(grid.tree());
-  std::uint64_t bad = tbb::parallel_reduce(
-      leaves.leafRange(), std::uint64_t(0),
-      [](const openvdb::tree::LeafManager<const Tree>::LeafRange& r, std::uint64_t n) {
+  Range range = tbb::parallel_reduce(
+      leaves.leafRange(), none,
+      [&](const openvdb::tree::LeafManager<const Tree>::LeafRange& r, Range acc) {
         for (auto leaf = r.begin(); leaf; ++leaf)
-          for (auto v = leaf->cbeginValueOn(); v; ++v) n += !std::isfinite(*v);
-        return n;
+          for (auto v = leaf->cbeginValueOn(); v; ++v)
+            if (std::isfinite(*v)) acc = merge(acc, {*v, *v});
+        return acc;
       },
-      [](std::uint64_t a, std::uint64_t b) { return a + b; });
+      merge);
   Tree::ValueOnCIter tile = grid.tree().cbeginValueOn();
-  tile.setMaxDepth(Tree::ValueOnCIter::LEAF_DEPTH - 1);  // tiles only; leaf voxels were counted above
-  for (; tile; ++tile) bad += std::isfinite(*tile) ? 0 : tile.getVoxelCount();
-  return bad;
+  tile.setMaxDepth(Tree::ValueOnCIter::LEAF_DEPTH - 1);  // tiles only; leaf voxels were visited above
+  for (; tile; ++tile)
+    if (std::isfinite(*tile)) range = merge(range, {*tile, *tile});
+  return range;
 }
 
-}  // namespace
+/// What `policy` makes of one value v (non-finite) that was active or not: the new value and whether it stays on.
+struct Fix {
+  float value;
+  bool active;
+};
+Fix fix_value(float v, bool active, NonFinite policy, std::pair<float, float> range, float background) {
+  const bool has_range = range.first <= range.second;
+  if (active && policy == NonFinite::Clamp && std::isinf(v) && has_range)
+    return {v > 0 ? range.second : range.first, true};
+  return {background, false};
+}
 
-namespace {
+/// Applies `policy` to every stored value (leaf voxels in parallel, then tiles) and returns the number of active
+/// voxels that were non-finite. Under Error the active ones are only counted (the caller refuses the grid).
+std::uint64_t apply_non_finite_policy(openvdb::FloatGrid& grid, NonFinite policy, float background) {
+  const std::pair<float, float> range = policy == NonFinite::Clamp ? finite_range(grid) : std::pair<float, float>{};
+  openvdb::tree::LeafManager<Tree> leaves(grid.tree());
+  std::atomic<std::uint64_t> bad{0};
+  leaves.foreach([&](Tree::LeafNodeType& leaf, std::size_t) {
+    std::uint64_t n = 0;
+    for (openvdb::Index i = 0; i < Tree::LeafNodeType::SIZE; ++i) {
+      const float v = leaf.getValue(i);
+      if (std::isfinite(v)) continue;
+      const bool on = leaf.isValueOn(i);
+      n += on;
+      if (on && policy == NonFinite::Error) continue;
+      const Fix f = fix_value(v, on, policy, range, background);
+      leaf.setValueOnly(i, f.value);
+      leaf.setActiveState(i, f.active);
+    }
+    bad += n;
+  });
+  std::uint64_t count = bad;
+  Tree::ValueAllIter tile = grid.tree().beginValueAll();
+  tile.setMaxDepth(Tree::ValueAllIter::LEAF_DEPTH - 1);
+  for (; tile; ++tile) {
+    if (std::isfinite(*tile)) continue;
+    const bool on = tile.isValueOn();
+    if (on) count += tile.getVoxelCount();
+    if (on && policy == NonFinite::Error) continue;
+    const Fix f = fix_value(*tile, on, policy, range, background);
+    tile.setValue(f.value);
+    tile.setActiveState(f.active);
+  }
+  return count;
+}
 
 /// default_grid_name's rule as an index (names need not be unique); -1 for no float grid.
 std::ptrdiff_t default_grid_index(const std::vector<GridInfo>& grids) {
@@ -85,14 +137,7 @@ std::ptrdiff_t default_grid_index(const std::vector<GridInfo>& grids) {
   return first_float;
 }
 
-}  // namespace
-
-std::string default_grid_name(const std::vector<GridInfo>& grids) {
-  const std::ptrdiff_t i = default_grid_index(grids);
-  return i < 0 ? "" : grids[std::size_t(i)].name;
-}
-
-Volume load_vdb(const std::string& path, const std::string& grid_name, EmptyGrid empty) {
+openvdb::FloatGrid::Ptr choose_float_grid(const std::string& path, const std::string& grid_name) {
   const openvdb::GridPtrVec grids = read_all_grids(path);
   openvdb::GridBase::Ptr chosen;
   if (grid_name.empty()) {
@@ -102,10 +147,10 @@ Volume load_vdb(const std::string& path, const std::string& grid_name, EmptyGrid
       kinds[i].active_voxels = grids[i]->activeVoxelCount();
     }
     const std::ptrdiff_t i = default_grid_index(kinds);
-    if (i >= 0) chosen = grids[std::size_t(i)];
-    if (!chosen)
+    if (i < 0)
       throw InvalidInput(file_message(path, "no float grid to load; " + describe_grids(grids) +
                                                 " (raysift renders scalar float grids only)"));
+    chosen = grids[std::size_t(i)];
   } else {
     for (const auto& g : grids)
       if (g->getName() == grid_name) {
@@ -118,15 +163,50 @@ Volume load_vdb(const std::string& path, const std::string& grid_name, EmptyGrid
       throw InvalidInput(file_message(path, "grid '" + grid_name + "' has value type '" + chosen->valueType() +
                                                 "', expected a float grid"));
   }
-  auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(chosen);
-  if (empty == EmptyGrid::Reject && grid->tree().activeVoxelCount() == 0)
-    throw InvalidInput(file_message(path, "grid '" + grid->getName() + "' has no active voxels (empty grid)"));
-  if (const std::uint64_t bad = count_non_finite(*grid))
-    throw InvalidInput(file_message(path, "grid '" + grid->getName() + "' has " + std::to_string(bad) +
-                                              " NaN/Inf voxel values"));
+  return openvdb::gridPtrCast<openvdb::FloatGrid>(chosen);
+}
+
+}  // namespace
+
+std::string default_grid_name(const std::vector<GridInfo>& grids) {
+  const std::ptrdiff_t i = default_grid_index(grids);
+  return i < 0 ? "" : grids[std::size_t(i)].name;
+}
+
+Volume load_vdb(const std::string& path, const std::string& grid_name, const LoadVdbOptions& options,
+                std::uint64_t* non_finite_count) {
+  auto grid = choose_float_grid(path, grid_name);
+  const std::string name = "grid '" + grid->getName() + "'";
+  float background = grid->background();
+  if (!std::isfinite(background)) {
+    if (options.non_finite == NonFinite::Error)
+      throw InvalidInput(file_message(path, name + " has a NaN/Inf background value (non-finite policy 'error'; "
+                                                   "'background' or 'clamp' loads it with background 0)"));
+    background = 0.0f;
+    grid->tree().root().setBackground(background, /*updateChildNodes=*/false);  // stored values: fixed below
+  }
+  const std::uint64_t bad = apply_non_finite_policy(*grid, options.non_finite, background);
+  if (bad != 0 && options.non_finite == NonFinite::Error)
+    throw InvalidInput(file_message(path, name + " has " + std::to_string(bad) +
+                                              " NaN/Inf voxel values (non-finite policy 'error'; 'background' "
+                                              "or 'clamp' loads it)"));
+  if (non_finite_count) *non_finite_count = bad;
+  if (options.empty == EmptyGrid::Reject && grid->tree().activeVoxelCount() == 0)
+    throw InvalidInput(file_message(path, name + " has no active voxels (empty grid)"));
   auto impl = std::make_shared<Volume::Impl>();
   impl->grid = grid;
   return Volume(impl);
+}
+
+Volume load_vdb(const std::string& path, const std::string& grid_name, EmptyGrid empty) {
+  return load_vdb(path, grid_name, LoadVdbOptions{empty, NonFinite::Error});
+}
+
+NonFinite parse_non_finite(const std::string& name) {
+  if (name == "error") return NonFinite::Error;
+  if (name == "background") return NonFinite::Background;
+  if (name == "clamp") return NonFinite::Clamp;
+  throw InvalidInput("non-finite policy must be error|background|clamp, got '" + name + "'");
 }
 
 void save_vdb(const std::string& path, const Volume& volume, const SaveVdbOptions& options) {

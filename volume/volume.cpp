@@ -8,6 +8,8 @@
 #include <mutex>
 
 #include "core/errors.h"
+#include "core/memory_limit.h"
+#include "core/signals.h"
 #include "volume/detail/vdb_grid.h"
 
 namespace raysift::volume {
@@ -26,6 +28,28 @@ openvdb::math::Transform::Ptr scaled_transform(const Vec3d& voxel_size) {
   return openvdb::math::Transform::createLinearTransform(m);
 }
 
+/// world = origin + index * M in OpenVDB's row-vector convention: row a of M is the step of index axis a.
+openvdb::math::Transform::Ptr affine_transform(const std::array<Vec3d, 3>& axes, const Vec3d& origin) {
+  openvdb::math::Mat4d m = openvdb::math::Mat4d::identity();
+  for (int a = 0; a < 3; ++a)
+    for (int c = 0; c < 3; ++c) m[a][c] = axes[std::size_t(a)][c];
+  // Relative to the axes' scale, so a 1e-3 mm voxel is as valid as a 1 m one.
+  const double scale = length(axes[0]) * length(axes[1]) * length(axes[2]);
+  if (!std::isfinite(m.det()) || !(std::abs(m.det()) > 1e-9 * scale))
+    throw InvalidInput("volume axes must be finite and linearly independent");
+  m.setTranslation(openvdb::Vec3d(origin.x, origin.y, origin.z));
+  return openvdb::math::Transform::createLinearTransform(m);
+}
+
+openvdb::math::Transform::Ptr dense_transform(const DenseSpec& spec) {
+  if (spec.axes_ws) return affine_transform(*spec.axes_ws, spec.origin_ws);
+  const bool uniform = spec.voxel_size.x == spec.voxel_size.y && spec.voxel_size.y == spec.voxel_size.z;
+  openvdb::math::Transform::Ptr xform =
+      uniform ? openvdb::math::Transform::createLinearTransform(spec.voxel_size.x) : scaled_transform(spec.voxel_size);
+  xform->postTranslate(openvdb::Vec3d(spec.origin_ws.x, spec.origin_ws.y, spec.origin_ws.z));
+  return xform;
+}
+
 std::shared_ptr<Volume::Impl> empty_impl() {
   detail::ensure_openvdb_initialized();
   auto impl = std::make_shared<Volume::Impl>();
@@ -34,6 +58,10 @@ std::shared_ptr<Volume::Impl> empty_impl() {
   return impl;
 }
 }  // namespace
+
+std::uint64_t grid_bytes_upper_bound(std::uint64_t active_voxels) {
+  return saturating_product(active_voxels / 2 + 1, 9);
+}
 
 Volume::Volume() : impl_(empty_impl()) {}
 Volume::Volume(std::shared_ptr<Impl> impl) : impl_(std::move(impl)) { RAYSIFT_CHECK(impl_ && impl_->grid); }
@@ -46,16 +74,19 @@ Volume Volume::from_function(const DenseSpec& spec, const std::function<float(in
   if (!(spec.voxel_size.x > 0 && spec.voxel_size.y > 0 && spec.voxel_size.z > 0) || !is_finite(spec.voxel_size))
     throw InvalidInput("voxel size must be positive and finite");
   detail::ensure_openvdb_initialized();
+  const openvdb::math::Transform::Ptr xform = dense_transform(spec);  // throws before any work
   using Tree = openvdb::FloatTree;
   // Each z-slab builds its own tree, merged afterwards: deterministic and lock-free.
   auto build = [&](const tbb::blocked_range<int>& r, Tree::Ptr tree) {
     openvdb::tree::ValueAccessor<Tree> acc(*tree);
-    for (int k = r.begin(); k < r.end(); ++k)
+    for (int k = r.begin(); k < r.end(); ++k) {
+      throw_if_cancelled();  // Ctrl-C during make-volume or import: one check per z-slice
       for (int j = 0; j < spec.dims.y; ++j)
         for (int i = 0; i < spec.dims.x; ++i) {
           const float v = value(i, j, k);
           if (!(std::abs(v - spec.background) <= spec.tolerance)) acc.setValueOn(openvdb::Coord(i, j, k), v);
         }
+    }
     return tree;
   };
   Tree::Ptr tree = tbb::parallel_reduce(
@@ -74,11 +105,6 @@ Volume Volume::from_function(const DenseSpec& spec, const std::function<float(in
   impl->grid = openvdb::FloatGrid::create(tree);
   impl->grid->setName(name);
   impl->grid->setGridClass(openvdb::GRID_FOG_VOLUME);
-  const bool uniform = spec.voxel_size.x == spec.voxel_size.y && spec.voxel_size.y == spec.voxel_size.z;
-  openvdb::math::Transform::Ptr xform =
-      uniform ? openvdb::math::Transform::createLinearTransform(spec.voxel_size.x)
-              : scaled_transform(spec.voxel_size);
-  xform->postTranslate(openvdb::Vec3d(spec.origin_ws.x, spec.origin_ws.y, spec.origin_ws.z));
   impl->grid->setTransform(xform);
   return Volume(impl);
 }

@@ -1,9 +1,11 @@
 #pragma once
 /// \file The Volume type: a sparse OpenVDB FloatGrid owned by volume/, with its index->world transform.
 /// Other modules see only this class; OpenVDB types stay inside volume/ (volume/detail/vdb_grid.h).
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,9 +33,17 @@ struct DenseSpec {
   Vec3i dims;
   Vec3d voxel_size{1, 1, 1};
   Vec3d origin_ws{0, 0, 0};    ///< world position of voxel (0,0,0)
+  /// If set, axes_ws[a] is the world step of index axis a (rotation, shear and flips allowed; voxel_size is
+  /// then ignored): world = origin_ws + i*axes_ws[0] + j*axes_ws[1] + k*axes_ws[2]. The axes must be
+  /// linearly independent.
+  std::optional<std::array<Vec3d, 3>> axes_ws = std::nullopt;
   float background = 0.0f;
   float tolerance = 0.0f;      ///< |v - background| <= tolerance stays inactive
 };
+
+/// Upper bound on the memory of a grid with `active_voxels` active voxels in 8^3 leaves: 4 bytes per value
+/// plus the leaf masks and headers (about 4.3 bytes per voxel), rounded up to 4.5. Saturates at UINT64_MAX.
+std::uint64_t grid_bytes_upper_bound(std::uint64_t active_voxels);
 
 class Volume {
  public:
@@ -43,7 +53,8 @@ class Volume {
   explicit Volume(std::shared_ptr<Impl> impl);
 
   /// Builds a sparse grid from a dense value function, in parallel. Voxels equal to the background
-  /// within the tolerance stay inactive. \throw InvalidInput for non-positive dims or voxel size.
+  /// within the tolerance stay inactive. \throw InvalidInput for non-positive dims or voxel size, or
+  /// axes_ws that are not finite and linearly independent.
   static Volume from_function(const DenseSpec& spec, const std::function<float(int i, int j, int k)>& value,
                               const std::string& name = "density");
 

@@ -7,6 +7,7 @@
 
 #include "apps/raysift/cli_checks.h"
 #include "apps/raysift/command.h"
+#include "apps/raysift/guard_flags.h"
 #include "core/errors.h"
 #include "core/timer.h"
 #include "volume/import.h"
@@ -47,6 +48,7 @@ RegisterCommand reg(
       sub.add_option("--tolerance", opt->tolerance, "|v - background| <= tolerance stays inactive")
           ->check(number_in(0, INFINITY))->capture_default_str();
       sub.add_flag("--half", opt->half, "store values as 16-bit floats on disk (about half the file size)");
+      add_max_memory_flag(sub, common);
       sub.footer(
           "Examples:\n"
           "  raysift import engine.raw.gz --dims 256,256,128 --type u8 -o engine.vdb\n"
@@ -65,6 +67,8 @@ RegisterCommand reg(
         options.grid_name = opt->grid;
         options.background = opt->background;
         options.tolerance = opt->tolerance;
+        const MemoryLimit limit = memory_limit(common);
+        options.memory_limit = &limit;
 
         Timer timer;
         volume::Volume vol;

@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "apps/raysift/command.h"
+#include "apps/raysift/guard_flags.h"
 #include "core/errors.h"
 #include "core/scene.h"
 #include "core/timer.h"
@@ -78,6 +79,7 @@ RegisterCommand reg("info", "describe the grids of a .vdb file (bbox, voxel size
                           ->capture_default_str();
                       sub.footer("Examples:\n  raysift info datasets/engine_ct.vdb\n"
                                  "  raysift info smoke.vdb --grid density --stats smoke_info.json\n");
+                      add_non_finite_flag(sub, common);
                       return [opt, &common] {
                         std::string path = opt->volume, grid = opt->grid;
                         if (!common.scene_path.empty()) {
@@ -97,7 +99,8 @@ RegisterCommand reg("info", "describe the grids of a .vdb file (bbox, voxel size
                         std::string hist_grid;
                         timer.reset();
                         if (!grid.empty()) {
-                          const volume::Volume vol = volume::load_vdb(path, grid, volume::EmptyGrid::Allow);
+                          const volume::Volume vol = volume::load_vdb(
+                              path, grid, {volume::EmptyGrid::Allow, non_finite_policy(common)});
                           hist = volume::compute_histogram(vol, opt->bins);
                           hist_grid = vol.name();
                           stats["histogram"] = {{"grid", hist_grid}, {"min", hist.min}, {"max", hist.max},

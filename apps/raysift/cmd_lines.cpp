@@ -7,6 +7,7 @@
 
 #include "apps/raysift/cli_checks.h"
 #include "apps/raysift/command.h"
+#include "core/output_set.h"
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/image.h"
@@ -198,9 +199,12 @@ RegisterCommand reg(
         if (!common.quiet && (k.nonmanifold_vertices > 0 || k.degenerate_faces > 0))
           std::cerr << "raysift lines: note: " << in.mesh_path << ": skipped " << k.nonmanifold_vertices
                     << " non-manifold vertices and " << k.degenerate_faces << " zero-area faces\n";
-        write_image(opt->out, r.picture);
-        if (!opt->svg.empty()) features::write_lines_svg(opt->svg, r.visible, cam, lib.picture.line_width_px);
-        if (r.importance) write_image(opt->importance, r.importance->values);
+        OutputSet outputs;  // picture, SVG and importance appear together or not at all
+        write_image(outputs.stage(opt->out), r.picture);
+        if (!opt->svg.empty())
+          features::write_lines_svg(outputs.stage(opt->svg), r.visible, cam, lib.picture.line_width_px);
+        if (r.importance) write_image(outputs.stage(opt->importance), r.importance->values);
+        outputs.commit();
         if (common.verbose)
           std::cerr << "lines: " << mesh.triangle_count() << " triangles, " << r.extracted.segments.size()
                     << " segments, " << r.visible.segments.size() << " visible pieces; curvature "

@@ -4,6 +4,7 @@
 
 #include "apps/raysift/cli_checks.h"
 #include "apps/raysift/command.h"
+#include "core/output_set.h"
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/timer.h"
@@ -48,8 +49,10 @@ RegisterCommand reg(
         so.triangles = opt->triangles;
         const nrr::GeneratedScene scene = nrr::make_scene(kind, so);
         const std::string views_path = views_path_for(opt->out);
-        mesh::write_mesh(opt->out, scene.mesh);
-        nrr::write_views_file(views_path, scene.views);
+        OutputSet outputs;  // the mesh and its views file appear together or not at all
+        mesh::write_mesh(outputs.stage(opt->out), scene.mesh);
+        nrr::write_views_file(outputs.stage(views_path), scene.views);
+        outputs.commit();
         if (!common.quiet)
           std::cout << "raysift make-scene: " << opt->kind << ": " << scene.mesh.triangle_count() << " triangles -> "
                     << opt->out << ", views -> " << views_path << "\n";

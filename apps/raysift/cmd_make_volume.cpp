@@ -1,4 +1,5 @@
 // raysift make-volume: write an analytic test volume (volume/generate.h) as a .vdb file.
+#include <algorithm>
 #include <cstdio>
 #include <functional>
 #include <map>
@@ -6,6 +7,7 @@
 #include <set>
 
 #include "apps/raysift/command.h"
+#include "apps/raysift/guard_flags.h"
 #include "core/errors.h"
 #include "core/timer.h"
 #include "volume/generate.h"
@@ -119,6 +121,7 @@ RegisterCommand reg(
       sub.add_option("--ijk", opt->ijk, "single-voxel: voxel index I,J,K (default: nearest the centre)")
           ->delimiter(',')->expected(3);
       sub.add_flag("--half", opt->half, "store values as 16-bit floats on disk");
+      add_max_memory_flag(sub, common);
       sub.footer(
           "Blobs use --seed. Examples:\n"
           "  raysift make-volume ball --dims 64,64,64 --radius 24 -o ball.vdb\n"
@@ -139,6 +142,15 @@ RegisterCommand reg(
         grid.voxel_size = opt->voxel_size;
         grid.name = opt->grid;
         if (!opt->center.empty()) grid.center_is = Vec3d(opt->center[0], opt->center[1], opt->center[2]);
+        if (opt->kind != "empty" && opt->kind != "single-voxel" &&
+            std::all_of(opt->dims.begin(), opt->dims.end(), [](int d) { return d > 0; }))
+          require_memory(volume::grid_bytes_upper_bound(saturating_product(
+                             saturating_product(std::uint64_t(opt->dims[0]), std::uint64_t(opt->dims[1])),
+                             std::uint64_t(opt->dims[2]))),
+                         memory_limit(common), SizeSource::Flag,
+                         "make-volume " + opt->kind + " --dims " + std::to_string(opt->dims[0]) + "," +
+                             std::to_string(opt->dims[1]) + "," + std::to_string(opt->dims[2]) +
+                             " (every voxel may be active)");
         Timer timer;
         volume::Volume vol;
         try {

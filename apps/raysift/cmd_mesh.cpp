@@ -1,5 +1,6 @@
 // raysift mesh: iso-surfaces of a volume as one triangle mesh. Flow: parse -> load volume and TF -> the
 // library's iso-surface pipeline (isosurface/pipeline.h) -> write all surfaces into one mesh file -> stats.
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <limits>
@@ -8,6 +9,7 @@
 
 #include "apps/raysift/cli_checks.h"
 #include "apps/raysift/command.h"
+#include "apps/raysift/guard_flags.h"
 #include "apps/raysift/volume_input.h"
 #include "core/errors.h"
 #include "core/file_util.h"
@@ -16,6 +18,7 @@
 #include "mesh/mesh_analysis.h"
 #include "mesh/mesh_io.h"
 #include "core/progress.h"
+#include "core/signals.h"
 #include "isosurface/pipeline.h"
 #include "volume/transfer_function.h"
 
@@ -62,15 +65,18 @@ std::string echo_command(const MeshCliOptions& o, const std::vector<double>& iso
   return s.str();
 }
 
-/// --iso values, each checked against the grid's data range.
+/// --iso values, each checked against the grid's data range. The background counts: inactive voxels read as it,
+/// so a constant-valued solid still has its surface between the two.
 std::vector<double> given_iso_values(const MeshCliOptions& o, const volume::GridInfo& info) {
   std::vector<double> values;
   if (o.iso.empty()) return values;
+  const double lo = std::min(info.value_min, info.background), hi = std::max(info.value_max, info.background);
   for (const double v : o.iso) {
-    if (v < info.value_min || v > info.value_max) {
-      std::ostringstream range;
-      range << "within the data range [" << info.value_min << ", " << info.value_max << "] of grid '" << info.name << "'";
-      bad_flag("--iso", range.str(), std::to_string(v));
+    if (v < lo || v > hi) {
+      std::ostringstream range, got;
+      range << "within the data range [" << lo << ", " << hi << "] of grid '" << info.name << "' (background included)";
+      got << v;
+      bad_flag("--iso", range.str(), got.str());
     }
     values.push_back(v);
   }
@@ -115,13 +121,16 @@ Json stages_json(const isosurface::StageTimes& t) {
 
 void run(const MeshCliOptions& o, const CommonOptions& common) {
   validate(o);
-  VolumeInput input = load_volume_input(o.volume, o.grid, o.tf, o.tf_normalized, common.scene_path, "mesh");
+  VolumeInput input = load_volume_input(o.volume, o.grid, o.tf, o.tf_normalized, common.scene_path, common, "mesh");
   if (!input.tf && o.iso.empty())
     throw UsageError("mesh needs --tf TF.json (or a --scene with a 'transfer_function') or --iso; see --help");
   isosurface::PipelineOptions options = pipeline_options(o);
   options.iso_values = given_iso_values(o, input.info);
   ProgressBar bar("mesh", !common.quiet);
   options.progress = [&bar](double f) { bar.update(f); };
+  options.cancel = &cancel_flag();
+  const MemoryLimit limit = memory_limit(common);
+  options.marching_cubes.memory_limit = &limit;
 
   isosurface::IsosurfaceSet set;
   try {
@@ -191,6 +200,8 @@ RegisterCommand reg(
           "Examples:\n"
           "  raysift mesh engine.vdb --tf engine_tf.json -o engine.ply --stats mesh_stats.json\n"
           "  raysift mesh engine.vdb --iso 80.5,150.5 --smooth 20 --faces 100000 -o engine.obj\n");
+      add_non_finite_flag(sub, common);
+      add_max_memory_flag(sub, common);
       return [opt, &common] { run(*opt, common); };
     });
 

@@ -10,6 +10,7 @@
 
 #include "apps/raysift/cli_checks.h"
 #include "apps/raysift/command.h"
+#include "core/output_set.h"
 #include "core/errors.h"
 #include "core/timer.h"
 #include "mesh/mesh_io.h"
@@ -161,12 +162,16 @@ void print_summary(const NrrCliOptions& o, const nrr::NrrPipelineResult& r) {
 
 void write_images(const std::string& out_dir, const nrr::NrrPipelineResult& r, bool with_metrics) {
   const std::filesystem::path dir(out_dir);
-  std::filesystem::create_directories(dir);  // only now: a failed run leaves no folder behind
+  OutputSet outputs;  // every image or none, and no folder left behind by a failed run
+  outputs.make_directories(dir.string());
   for (std::size_t i = 0; i < r.images.size(); ++i) {
     const std::string stem = (dir / ("image_" + std::to_string(i))).string();
-    nrr::write_depth_image(r.images[i], stem + ".exr", stem + ".png");
-    if (with_metrics) write_image(stem + "_samples.png", nrr::sample_class_image(r.images[i], r.metrics.sample_classes[i]));
+    nrr::write_depth_image(r.images[i], outputs.stage(stem + ".exr"), outputs.stage(stem + ".png"));
+    if (with_metrics)
+      write_image(outputs.stage(stem + "_samples.png"),
+                  nrr::sample_class_image(r.images[i], r.metrics.sample_classes[i]));
   }
+  outputs.commit();
 }
 
 RegisterCommand reg(

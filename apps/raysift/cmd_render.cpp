@@ -2,16 +2,19 @@
 // caster) -> run the selected mode -> write. A new mode adds one entry to `modes()` (and its flags in
 // render_flags.cpp); everything before and after the dispatch is shared, so all modes composite and write alike.
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <map>
 #include <memory>
 #include <sstream>
 
 #include "apps/raysift/command.h"
+#include "apps/raysift/guard_flags.h"
 #include "apps/raysift/render_flags.h"
 #include "apps/raysift/sampling_stats.h"
 #include "core/file_util.h"
 #include "core/image.h"
+#include "core/signals.h"
 #include "core/progress.h"
 #include "core/timer.h"
 #include "sampling/camera_path.h"
@@ -47,7 +50,10 @@ const std::map<std::string, ModeFunction>& modes() {
       {"full",
        [](const RenderInputs&, const volume::RayCaster& caster, const CommonOptions& common) {
          ProgressBar bar("render", !common.quiet);
-         volume::RenderResult r = volume::render_full(caster, [&bar](double f) { bar.update(f); });
+         volume::RenderResult r = volume::render_full(caster, [&bar](double f) {
+           throw_if_cancelled();  // unwinds out of the TBB tiles; nothing has been written yet
+           bar.update(f);
+         });
          return ModeOutput{std::move(r.image), r.rays_traced, r.samples, Json::object()};
        }},
       {"prioritized", sampled_mode},
@@ -87,6 +93,11 @@ void render_path(const PathCliOptions& p, const RenderCliOptions& o, const Rende
   request.geometry = in.sampled.geometry;
   request.feature_mesh = in.sampled.feature_mesh;
   request.feature_cache = in.sampled.feature_cache;
+  // Frames stream out one by one, each atomically; the manifest, written last, marks a complete sequence, so a
+  // stale one from an earlier run must not outlive the first new frame.
+  const std::string manifest = sampling::frame_manifest_name(o.out);
+  std::error_code ec;
+  std::filesystem::remove(manifest, ec);
   const sampling::PathRenderResult r = sampling::run_path_request(
       in.volume, *in.tf, in.options, in.camera, request, [&](const sampling::PathFrame& frame, const ImageRGBA& image) {
         const std::string name = sampling::frame_file_name(o.out, frame.index);
@@ -100,6 +111,10 @@ void render_path(const PathCliOptions& p, const RenderCliOptions& o, const Rende
   stats["frame_files"] = {sampling::frame_file_name(o.out, 0), sampling::frame_file_name(o.out, int(r.frames.size()) - 1)};
   stats["times_ms"] = {{"features_setup", r.features_setup_ms}, {"total", r.total_ms}};
   stats["mode"] = o.mode;
+  Json files = Json::array();
+  for (const sampling::PathFrame& f : r.frames) files.push_back(sampling::frame_file_name(o.out, f.index));
+  write_json_file(manifest, {{"camera_path", p.camera_path}, {"frames", r.frames.size()}, {"files", files}});
+  stats["manifest"] = manifest;
   if (common.verbose)
     std::cerr << "rendered " << r.frames.size() << " frames to " << o.out << " in " << r.total_ms << " ms\n";
   write_stats_if_requested(common, stats);
@@ -111,6 +126,8 @@ RegisterCommand reg(
       auto opt = std::make_shared<RenderCliOptions>();
       auto path = std::make_shared<PathCliOptions>();
       add_render_options(sub, *opt, *path, mode_list());
+      add_non_finite_flag(sub, common);
+      add_max_memory_flag(sub, common);
       return [opt, path, &common] {
         const Timer total;
         check_render_flags(*path, *opt);

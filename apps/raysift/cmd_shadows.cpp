@@ -7,6 +7,7 @@
 
 #include "apps/raysift/cli_checks.h"
 #include "apps/raysift/command.h"
+#include "core/output_set.h"
 #include "core/file_util.h"
 #include "core/image.h"
 #include "core/scene.h"
@@ -197,13 +198,16 @@ RegisterCommand reg(
         if (opt->height_flag->count() > 0) camera.height = opt->height;
 
         const nrr::ShadowPipelineResult run = nrr::run_shadow_pipeline(in.mesh, sampled, in.light, camera, options);
+        OutputSet outputs;  // the image and the error map appear together or not at all
         if (file_extension(opt->out) == ".exr") {
-          write_image(opt->out, run.visible_fraction);
+          write_image(outputs.stage(opt->out), run.visible_fraction);
         } else {
-          write_image(opt->out, run.shaded);
+          write_image(outputs.stage(opt->out), run.shaded);
         }
         if (!opt->error_map.empty())
-          write_image(opt->error_map, nrr::error_map_image(run.errors, run.receivers.width, run.receivers.height));
+          write_image(outputs.stage(opt->error_map),
+                      nrr::error_map_image(run.errors, run.receivers.width, run.receivers.height));
+        outputs.commit();
         print_and_write(*opt, common, run, nrr::area_light_to_json(in.light), in.mesh.triangle_count(), total.elapsed_ms());
       };
     });

@@ -10,6 +10,7 @@
 
 #include "apps/raysift/cli_checks.h"
 #include "apps/raysift/command.h"
+#include "apps/raysift/guard_flags.h"
 #include "apps/raysift/sampling_flags.h"
 #include "apps/raysift/run_program.h"
 #include "apps/raysift/volume_input.h"
@@ -103,6 +104,7 @@ RegisterCommand reg(
       sub.footer(
           "Example:\n  raysift sweep datasets/engine_ct_scene.json --ray-fractions 0.1,0.2,0.4,0.7 -o trade.csv "
           "--plot trade.png\n");
+      add_non_finite_flag(sub, common);
       return [opt, &common] {
         sampling::TradeOptions trade;
         trade.ray_fractions = opt->fractions;
@@ -117,7 +119,7 @@ RegisterCommand reg(
           throw UsageError(std::string("--features: ") + e.what() + "; see --help");
         }
 
-        const VolumeInput in = load_volume_input("", opt->grid, opt->tf, opt->tf_normalized, opt->scene, "sweep");
+        const VolumeInput in = load_volume_input("", opt->grid, opt->tf, opt->tf_normalized, opt->scene, common, "sweep");
         if (!in.tf) throw InvalidInput(file_message(opt->scene, "the scene has no 'transfer_function'"));
         CameraSpec camera = in.scene.camera ? *in.scene.camera : volume::fit_camera(in.volume, CameraSpec{}.width, CameraSpec{}.height);
         if (opt->width != -1) camera.width = opt->width;

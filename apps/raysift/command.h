@@ -19,6 +19,8 @@ struct CommonOptions {
   bool quiet = false;
   std::string stats_path;     ///< --stats FILE: JSON with timings and counts
   std::string scene_path;     ///< --scene FILE
+  std::string max_memory;     ///< --max-memory SIZE (guard_flags.h); "" = MemAvailable
+  std::string non_finite = "error";  ///< --non-finite error|background|clamp (guard_flags.h)
 };
 
 using RunFunction = std::function<void()>;

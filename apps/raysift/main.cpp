@@ -3,6 +3,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <csignal>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -10,6 +11,7 @@
 
 #include "apps/raysift/command.h"
 #include "core/errors.h"
+#include "core/signals.h"
 
 namespace raysift::app {
 
@@ -132,13 +134,17 @@ int main(int argc, char** argv) {
   try {
     const int threads = common.threads > 0 ? common.threads : tbb::this_task_arena::max_concurrency();
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+    install_cancel_handlers();
     run();
     return 0;
-  } catch (const UsageError& e) {
-    std::cerr << "raysift: error: " << e.what() << "\n";
-    return 2;
   } catch (const std::exception& e) {
-    std::cerr << "raysift: error: " << e.what() << "\n";
-    return 1;
+    if (cancel_signal() == 0) {
+      std::cerr << "raysift: error: " << e.what() << "\n";
+      return dynamic_cast<const UsageError*>(&e) ? 2 : 1;
+    }
   }
+  // Whatever a signal interrupted failed as a consequence; the staged outputs are gone by now.
+  std::cerr << "raysift: interrupted by " << (cancel_signal() == SIGTERM ? "SIGTERM" : "SIGINT")
+            << "; no output written\n";
+  return 128 + cancel_signal();
 }

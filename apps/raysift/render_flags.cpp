@@ -5,11 +5,14 @@
 #include <sstream>
 
 #include "apps/raysift/cli_checks.h"
+#include "apps/raysift/guard_flags.h"
 #include "apps/raysift/sampling_flags.h"
 #include "apps/raysift/volume_input.h"
 #include "core/file_util.h"
+#include "core/memory_limit.h"
 #include "core/scene.h"
 #include "sampling/camera_path.h"
+#include "volume/raycaster.h"
 
 namespace raysift::app {
 namespace {
@@ -126,8 +129,18 @@ void check_render_flags(PathCliOptions& p, RenderCliOptions& o) {
   check_mode_flags(o);
 }
 
+/// The image buffers of one render. The sampled modes keep an importance map, the traced samples, their masks
+/// and a composited copy beside the frame; progressive rendering adds its sample accumulator. Counted as
+/// multiples of the full render's colour+depth buffers (20 bytes per pixel).
+std::uint64_t render_bytes(const RenderCliOptions& o, const CameraSpec& camera) {
+  const std::uint64_t frame = volume::render_full_bytes(camera.width, camera.height);
+  if (o.mode == "full") return frame;
+  return frame * (o.progressive > 0 ? 5 : 4);
+}
+
 RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common) {
-  VolumeInput input = load_volume_input(o.volume, o.grid, o.tf, o.tf_normalized, common.scene_path, "render");
+  VolumeInput input = load_volume_input(o.volume, o.grid, o.tf, o.tf_normalized, common.scene_path, common, "render",
+                                        volume::EmptyGrid::Allow);
   if (!input.tf) throw UsageError("render needs --tf TF.json or a --scene with a 'transfer_function'; see --help");
   const Scene& scene = input.scene;
   const volume::GridInfo& info = input.info;
@@ -158,6 +171,9 @@ RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common
   } else {
     in.camera = volume::fit_camera(in.volume, width, height);
   }
+  require_memory(render_bytes(o, in.camera), memory_limit(common), SizeSource::Flag,
+                 "a " + std::to_string(in.camera.width) + "x" + std::to_string(in.camera.height) + " " + o.mode +
+                     " render");
 
   in.options.step_voxels = o.step;
   in.options.shading = o.shading == "phong" ? volume::Shading::Phong : volume::Shading::None;

@@ -1,24 +1,40 @@
 #include "apps/raysift/volume_input.h"
 
+#include <algorithm>
+#include <iostream>
+
+#include "apps/raysift/guard_flags.h"
 #include "core/errors.h"
 #include "volume/vdb_io.h"
 
 namespace raysift::app {
 
 VolumeInput load_volume_input(const std::string& volume_arg, const std::string& grid, const std::string& tf_path,
-                              bool tf_normalized, const std::string& scene_path, const std::string& command) {
+                              bool tf_normalized, const std::string& scene_path, const CommonOptions& common,
+                              const std::string& command,
+                              volume::EmptyGrid empty) {
   VolumeInput in;
   if (!scene_path.empty()) in.scene = load_scene(scene_path);
   in.volume_path = !volume_arg.empty() ? volume_arg : in.scene.volume;
   if (in.volume_path.empty())
     throw UsageError(command + " needs a VOLUME argument or a --scene with a 'volume'; see --help");
-  in.volume = volume::load_vdb(in.volume_path, !grid.empty() ? grid : in.scene.grid);
+  volume::LoadVdbOptions load;
+  load.empty = empty;
+  load.non_finite = non_finite_policy(common);
+  in.volume = volume::load_vdb(in.volume_path, !grid.empty() ? grid : in.scene.grid, load, &in.non_finite_voxels);
+  if (in.non_finite_voxels > 0 && !common.quiet)
+    std::cerr << "raysift: warning: " << in.volume_path << ": " << in.non_finite_voxels << " NaN/Inf voxels loaded with --non-finite "
+              << common.non_finite << "\n";
   in.info = in.volume.info();
 
   volume::TfJsonOptions tf_options;
   tf_options.normalized = tf_normalized;
   tf_options.data_min = in.info.value_min;
   tf_options.data_max = in.info.value_max;
+  if (tf_options.data_min == tf_options.data_max) {  // a constant solid: normalise over it and the background
+    tf_options.data_min = std::min(in.info.value_min, in.info.background);
+    tf_options.data_max = std::max(in.info.value_max, in.info.background);
+  }
   if (!tf_path.empty()) {
     in.tf_source = tf_path;
     in.tf = std::make_unique<volume::TransferFunction>(volume::load_transfer_function(tf_path, tf_options));

@@ -206,19 +206,53 @@ TEST(ImportNrrd, AttachedRawGzipAsciiAndDetachedAgree) {
   EXPECT_TRUE(is_nrrd_path(dir + "/det.NHDR"));
 }
 
-TEST(ImportNrrd, SpaceDirectionsGiveSpacingAndOptionsOverride) {
+// Rotated, mirrored (det = -1) directions and an origin, checked against world = o + i*d0 + j*d1 + k*d2
+// written out by hand: d0 = (0,0.3,0.4), d1 = (2,0,0), d2 = (0,-0.8,0.6), o = (10,-5,3).
+TEST(ImportNrrd, SpaceDirectionsAndOriginBecomeTheAffineTransform) {
   const std::string dir = test::make_temp_dir("nrrd_dirs");
+  std::string data;
+  for (int v = 1; v <= 12; ++v) data.push_back(char(v));  // 2x3x2 voxels, all active
   write_file(dir + "/d.nrrd",
-             "NRRD0005\ntype: uint8\ndimension: 3\nsizes: 2 1 1\nspace: right-anterior-superior\n"
-             "space directions: (0,0.3,0.4) (2,0,0) (0,0,1.5)\nencoding: raw\n\n" +
-                 std::string("\x05\x00", 2));
+             "NRRD0005\ntype: uint8\ndimension: 3\nsizes: 2 3 2\nspace: right-anterior-superior\n"
+             "space directions: (0,0.3,0.4) (2,0,0) (0,-0.8,0.6)\nspace origin: (10,-5,3)\nencoding: raw\n\n" +
+                 data);
   const Volume v = import_nrrd(dir + "/d.nrrd");
+  struct Case {
+    Vec3d index, world;
+  };
+  const Case cases[] = {{{0, 0, 0}, {10, -5, 3}},       {{1, 0, 0}, {10, -4.7, 3.4}},
+                        {{0, 1, 0}, {12, -5, 3}},       {{0, 0, 1}, {10, -5.8, 3.6}},
+                        {{1, 2, 1}, {14, -5.5, 4.0}},   {{0.5, 1.5, 0.5}, {13, -5.25, 3.5}}};
+  for (const Case& c : cases) {
+    const Vec3d w = v.index_to_world(c.index), i = v.world_to_index(c.world);
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_NEAR(w[a], c.world[a], 1e-12) << "index " << c.index << " axis " << a;
+      EXPECT_NEAR(i[a], c.index[a], 1e-12) << "world " << c.world << " axis " << a;
+    }
+  }
   EXPECT_NEAR(v.voxel_size().x, 0.5, 1e-12);
   EXPECT_NEAR(v.voxel_size().y, 2.0, 1e-12);
-  EXPECT_EQ(v.active_voxel_count(), 1u);
-  ImportOptions o;
+  EXPECT_NEAR(v.voxel_size().z, 1.0, 1e-12);
+  // World bbox of the active voxel centres: the extremes of the 8 corners i in {0,1}, j in {0,2}, k in {0,1}.
+  const GridInfo info = v.info();
+  const Vec3d lo{10, -5.8, 3}, hi{14, -4.7, 4};
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_NEAR(info.bbox_min[a], lo[a], 1e-12);
+    EXPECT_NEAR(info.bbox_max[a], hi[a], 1e-12);
+  }
+  ImportOptions o;  // --spacing keeps the directions, replaces their lengths
   o.spacing = Vec3d(1, 1, 1);
-  EXPECT_EQ(import_nrrd(dir + "/d.nrrd", o).voxel_size(), Vec3d(1, 1, 1));
+  const Vec3d w = import_nrrd(dir + "/d.nrrd", o).index_to_world({1, 1, 1});
+  const Vec3d expect{10 + 1.0, -5 + 0.6 - 0.8, 3 + 0.8 + 0.6};
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(w[a], expect[a], 1e-12);
+}
+
+TEST(ImportNrrd, DependentSpaceDirectionsAreRejected) {
+  const std::string dir = test::make_temp_dir("nrrd_dep");
+  write_file(dir + "/d.nrrd",
+             "NRRD0005\ntype: uint8\ndimension: 3\nsizes: 1 1 1\n"
+             "space directions: (1,0,0) (2,0,0) (0,0,1)\nencoding: raw\n\n" + std::string("\x05", 1));
+  EXPECT_THROW(import_nrrd(dir + "/d.nrrd"), InvalidInput);
 }
 
 TEST(ImportNrrd, MalformedHeadersNameTheLine) {

@@ -115,6 +115,25 @@ TEST(MarchingCubes, FlipReversesOrientation) {
   EXPECT_DOUBLE_EQ(b.signed_volume, -a.signed_volume);
 }
 
+TEST(MarchingCubes, MirroringTransformKeepsNormalsOutward) {
+  // A NRRD flip (negative determinant) mirrors the mesh; without correction every triangle would face inward
+  // and the signed volume would come out negative.
+  BallOptions ball;
+  ball.grid.dims = {24, 24, 24};
+  ball.radius_voxels = 8.0;
+  const Volume base = make_ball(ball);
+  auto impl = std::make_shared<Volume::Impl>();
+  impl->grid = base.impl().grid->deepCopy();
+  openvdb::math::Mat4d m = openvdb::math::Mat4d::identity();
+  m.preScale(openvdb::Vec3d(-1, 1, 1));
+  impl->grid->setTransform(openvdb::math::Transform::createLinearTransform(m));
+  const MeshAnalysis a = analyze_mesh(extract_isosurface(base, 0.5));
+  const MeshAnalysis b = analyze_mesh(extract_isosurface(Volume(impl), 0.5));
+  EXPECT_TRUE(b.is_watertight());
+  EXPECT_GT(b.signed_volume, 0.0);
+  EXPECT_NEAR(b.signed_volume, a.signed_volume, 1e-9 * a.signed_volume);  // same triangles, mirrored
+}
+
 TEST(MarchingCubes, TorusHasEulerCharacteristicZero) {
   TorusOptions torus;
   torus.grid.dims = {64, 64, 24};

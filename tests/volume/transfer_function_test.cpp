@@ -157,7 +157,7 @@ INSTANTIATE_TEST_SUITE_P(
     BadInputs, TfValidation,
     ::testing::Values(BadTf{"Unsorted", R"({"points": [[1,0,0,0,0],[0,0,0,0,1]]})"},
                       BadTf{"Duplicate", R"({"points": [[1,0,0,0,0],[1,0,0,0,1]]})"},
-                      BadTf{"OnePoint", R"({"points": [[1,0,0,0,0]]})"},
+                      BadTf{"NoPoints", R"({"points": []})"},
                       BadTf{"OpacityAboveOne", R"({"points": [[0,0,0,0,0],[1,0,0,0,1.5]]})"},
                       BadTf{"NegativeColour", R"({"points": [[0,-0.1,0,0,0],[1,0,0,0,1]]})"},
                       BadTf{"WrongArity", R"({"points": [[0,0,0,0],[1,0,0,0,1]]})"},
@@ -173,7 +173,18 @@ TEST(TransferFunction, ConstructorRejectsNanAndUnsorted) {
   EXPECT_THROW(TransferFunction({{0, 0, 0, 0, 0}, {std::nan(""), 0, 0, 0, 1}}), InvalidInput);
   EXPECT_THROW(TransferFunction({{0, 0, 0, 0, std::nanf("")}, {1, 0, 0, 0, 1}}), InvalidInput);
   EXPECT_THROW(TransferFunction({{1, 0, 0, 0, 0}, {0, 0, 0, 0, 1}}), InvalidInput);
-  EXPECT_THROW(TransferFunction({{0, 0, 0, 0, 0}}), InvalidInput);
+  EXPECT_THROW(TransferFunction(std::vector<TfPoint>{}), InvalidInput);
+}
+
+TEST(TransferFunction, OnePointIsConstant) {
+  const TransferFunction tf({{5.0, 0.25f, 0.5f, 0.75f, 0.125f}});
+  for (const double v : {-1e30, 0.0, 5.0, 5.5, 1e30}) {
+    const Rgba c = tf.evaluate(v);
+    EXPECT_EQ(c.r, 0.25f) << v;  // exact: both stored points are the given one
+    EXPECT_EQ(c.a, 0.125f) << v;
+  }
+  EXPECT_EQ(tf.domain_min(), 5.0);
+  EXPECT_GT(tf.domain_max(), 5.0);
 }
 
 TEST(TransferFunction, LoadNamesMissingFile) {

@@ -4,10 +4,12 @@
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "tests/support/test_support.h"
+#include "volume/detail/vdb_grid.h"
 #include "volume/generate.h"
 
 namespace raysift::volume {
@@ -128,6 +130,53 @@ TEST(VdbIo, EmptyGridRejectedUnlessAllowed) {
   const Volume density = load_vdb(kMixed, "density");
   EXPECT_EQ(density.active_voxel_count(), 2u);
   EXPECT_FLOAT_EQ(density.value_at({5, 6, 7}), 0.75f);
+}
+
+/// A 4^3 ramp (value i+j+k+1, all active) with NaN at (1,1,1), +Inf at (2,2,2), -Inf at (0,0,3) and an
+/// inactive NaN at (3,3,0); the finite active values then span [1, 10] minus the three replaced voxels.
+std::string save_non_finite_fixture(const std::string& dir) {
+  DenseSpec spec;
+  spec.dims = {4, 4, 4};
+  spec.background = 0.0f;
+  const Volume v = Volume::from_function(spec, [](int i, int j, int k) {
+    if (i == 1 && j == 1 && k == 1) return std::numeric_limits<float>::quiet_NaN();
+    if (i == 2 && j == 2 && k == 2) return std::numeric_limits<float>::infinity();
+    if (i == 0 && j == 0 && k == 3) return -std::numeric_limits<float>::infinity();
+    return float(i + j + k + 1);
+  });
+  v.impl().grid->tree().setValueOff(openvdb::Coord(3, 3, 0), std::numeric_limits<float>::quiet_NaN());
+  const std::string path = dir + "/non_finite.vdb";
+  save_vdb(path, v);
+  return path;
+}
+
+TEST(VdbIo, NonFinitePolicies) {
+  const std::string path = save_non_finite_fixture(test::make_temp_dir("vdb_nonfinite"));
+  const std::string msg = message_of<InvalidInput>([&] { load_vdb(path); });
+  EXPECT_NE(msg.find("has 3 NaN/Inf voxel values"), std::string::npos) << msg;  // the inactive NaN is not data
+
+  std::uint64_t count = 0;
+  const Volume bg = load_vdb(path, "", LoadVdbOptions{EmptyGrid::Reject, NonFinite::Background}, &count);
+  EXPECT_EQ(count, 3u);
+  EXPECT_EQ(bg.active_voxel_count(), 64u - 1u - 3u);  // (3,3,0) was inactive already
+  for (const Vec3i ijk : {Vec3i(1, 1, 1), Vec3i(2, 2, 2), Vec3i(0, 0, 3), Vec3i(3, 3, 0)}) {
+    EXPECT_EQ(bg.value_at(ijk), 0.0f) << ijk;
+    EXPECT_FALSE(bg.impl().grid->tree().isValueOn(openvdb::Coord(ijk.x, ijk.y, ijk.z))) << ijk;
+  }
+
+  const Volume clamped = load_vdb(path, "", LoadVdbOptions{EmptyGrid::Reject, NonFinite::Clamp}, &count);
+  EXPECT_EQ(count, 3u);
+  // Finite active extremes: 1 at (0,0,0), 10 at (3,3,3).
+  EXPECT_EQ(clamped.value_at({2, 2, 2}), 10.0f);
+  EXPECT_EQ(clamped.value_at({0, 0, 3}), 1.0f);
+  EXPECT_EQ(clamped.value_at({1, 1, 1}), 0.0f);
+  EXPECT_EQ(clamped.value_at({3, 3, 0}), 0.0f);
+  EXPECT_EQ(clamped.active_voxel_count(), 64u - 1u - 1u);  // only the NaN left
+  const GridInfo info = clamped.info();
+  EXPECT_EQ(info.value_min, 1.0);
+  EXPECT_EQ(info.value_max, 10.0);
+  EXPECT_EQ(parse_non_finite("clamp"), NonFinite::Clamp);
+  EXPECT_THROW(parse_non_finite("zero"), InvalidInput);
 }
 
 TEST(VdbIo, InspectListsEveryGridWithTypeAndStats) {
