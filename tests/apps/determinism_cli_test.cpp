@@ -24,6 +24,8 @@ struct DeterminismCase {
   std::vector<std::string> outputs;  ///< files, or folders whose every file is compared
 };
 
+void PrintTo(const DeterminismCase& c, std::ostream* os) { *os << c.name; }
+
 std::string with_threads(std::string s, int threads) {
   for (std::size_t at; (at = s.find("{t}")) != std::string::npos;) s.replace(at, 3, std::to_string(threads));
   return s;

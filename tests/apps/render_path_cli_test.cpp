@@ -50,7 +50,9 @@ TEST(RenderPathCli, OrbitWritesEveryFrameWithStats) {
   // --target-fps makes the ray count depend on timing; whatever it is, a frame that traced every ray is the full
   // render (checked against standalone renders below).
   for (const Json& f : stats.at("frames"))
-    if (f.at("rays_traced") == f.at("full_rays")) EXPECT_EQ(f.at("ssim_vs_full").get<double>(), 1.0);
+    if (f.at("rays_traced") == f.at("full_rays")) {
+      EXPECT_EQ(f.at("ssim_vs_full").get<double>(), 1.0);
+    }
 }
 
 const char* kTwoCameras = R"([{"eye": [600, 100, -150], "target": [127.5, 127.5, 63.5], "up": [0, 0, -1], "fov_y_deg": 30,
