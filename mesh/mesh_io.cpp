@@ -2,7 +2,10 @@
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
 
+#include <cctype>
 #include <cmath>
+#include <fstream>
+#include <sstream>
 
 #include "core/errors.h"
 #include "core/file_util.h"
@@ -16,6 +19,32 @@ void require_mesh_extension(const std::string& path) {
   const std::string ext = file_extension(path);
   if (ext != ".ply" && ext != ".obj" && ext != ".off")
     throw IoError(file_message(path, "unsupported mesh format '" + ext + "'; expected .ply, .obj or .off"));
+}
+
+/// Input that Debian's OpenMesh 9 does not survive, rejected before it gets there (found by tests/fuzz): a PLY
+/// header without `end_header` makes its reader loop forever, and an OBJ face corner without a vertex index
+/// ("f /1/1 ...") trips an assert that aborts the process.
+void reject_openmesh_traps(const std::string& path, const std::string& ext) {
+  if (ext != ".ply" && ext != ".obj") return;
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (ext == ".ply") {
+      if (line == "end_header") return;
+      continue;
+    }
+    std::istringstream tokens(line);
+    std::string word;
+    if (!(tokens >> word) || word != "f") continue;
+    for (std::string corner; tokens >> corner;) {
+      const std::size_t digit = corner[0] == '-' ? 1 : 0;
+      if (digit >= corner.size() || !std::isdigit(static_cast<unsigned char>(corner[digit])))
+        throw IoError(path + ":" + std::to_string(number) + ": face corner '" + corner +
+                           "' has no vertex index; expected v, v/vt, v//vn or v/vt/vn");
+    }
+  }
+  if (ext == ".ply") throw IoError(file_message(path, "malformed PLY: the header has no 'end_header' line"));
 }
 
 }  // namespace
@@ -35,6 +64,7 @@ void validate_mesh(const TriMesh& mesh, const std::string& what) {
 TriMesh read_mesh(const std::string& path, const MeshReadOptions& options) {
   require_readable_file(path);
   require_mesh_extension(path);
+  reject_openmesh_traps(path, file_extension(path));
   detail::OmPolyMesh poly;
   {
     detail::MuteOpenMeshLog mute;

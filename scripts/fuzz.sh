@@ -19,7 +19,8 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 targets=(transfer_function scene camera light nrrd raw ply obj)
-cmake -S . -B build-fuzz -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g -O1" \
+cmake -S . -B build-fuzz -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=Debug \
+  -DCMAKE_CXX_FLAGS_DEBUG="-g -O1 -fsanitize-ignorelist=$PWD/scripts/fuzz_ubsan_ignore.txt" \
   -DRAYSIFT_SANITIZE=fuzzer-no-link,address,undefined -DRAYSIFT_BUILD_FUZZ=ON \
   -DRAYSIFT_BUILD_TESTS=OFF -DRAYSIFT_BUILD_BENCH=OFF
 cmake --build build-fuzz -j2 --target "${targets[@]/#/fuzz_}"
@@ -30,6 +31,7 @@ run_one() {
   local t=$1 seconds=$2
   mkdir -p "build-fuzz/corpus/$t"
   if ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
+     LSAN_OPTIONS=suppressions=$PWD/scripts/sanitize_lsan.supp:print_suppressions=0 \
      "build-fuzz/tests/fuzz/fuzz_$t" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
        -artifact_prefix="build-fuzz/findings/$t-" -print_final_stats=1 \
        "build-fuzz/corpus/$t" "tests/fuzz/corpus/$t" > "build-fuzz/fuzz_$t.log" 2>&1; then
