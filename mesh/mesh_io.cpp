@@ -2,6 +2,7 @@
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <fstream>
@@ -21,17 +22,43 @@ void require_mesh_extension(const std::string& path) {
     throw IoError(file_message(path, "unsupported mesh format '" + ext + "'; expected .ply, .obj or .off"));
 }
 
+bool is_ply_type(const std::string& t) {
+  static const char* types[] = {"char",  "uchar",  "short", "ushort", "int",   "uint",    "float",   "double",
+                                "int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
+  return std::any_of(std::begin(types), std::end(types), [&](const char* k) { return t == k; });
+}
+
+/// One PLY header line is well formed: OpenMesh 9's header parser reads past malformed ones (a crash, or a loop).
+bool is_ply_header_line(const std::string& line) {
+  std::istringstream in(line);
+  std::string word, a, b, c, rest;
+  if (!(in >> word)) return false;
+  if (word == "comment" || word == "obj_info") return true;
+  if (word == "format") return (in >> a >> b) && !(in >> rest) &&
+                               (a == "ascii" || a == "binary_little_endian" || a == "binary_big_endian");
+  if (word == "element") {
+    long long count = -1;
+    return (in >> a >> count) && count >= 0 && !(in >> rest);
+  }
+  if (word != "property" || !(in >> a >> b)) return false;
+  if (a != "list") return is_ply_type(a) && !(in >> rest);
+  return is_ply_type(b) && (in >> c) && is_ply_type(c) && (in >> rest) && !(in >> word);
+}
+
 /// Input that Debian's OpenMesh 9 does not survive, rejected before it gets there (found by tests/fuzz): a PLY
-/// header without `end_header` makes its reader loop forever, and an OBJ face corner without a vertex index
-/// ("f /1/1 ...") trips an assert that aborts the process.
+/// header without `end_header` loops its reader forever and a malformed header line crashes it; an OBJ face
+/// corner without a vertex index ("f /1/1 ...") trips an assert that aborts the process.
 void reject_openmesh_traps(const std::string& path, const std::string& ext) {
   if (ext != ".ply" && ext != ".obj") return;
   std::ifstream in(path, std::ios::binary);
   std::string line;
   for (int number = 1; std::getline(in, line); ++number) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
+    const std::string where = path + ":" + std::to_string(number) + ": ";
     if (ext == ".ply") {
       if (line == "end_header") return;
+      if (number == 1 ? line != "ply" : !is_ply_header_line(line))
+        throw IoError(where + "malformed PLY header line '" + line.substr(0, 60) + "'");
       continue;
     }
     std::istringstream tokens(line);
@@ -40,8 +67,7 @@ void reject_openmesh_traps(const std::string& path, const std::string& ext) {
     for (std::string corner; tokens >> corner;) {
       const std::size_t digit = corner[0] == '-' ? 1 : 0;
       if (digit >= corner.size() || !std::isdigit(static_cast<unsigned char>(corner[digit])))
-        throw IoError(path + ":" + std::to_string(number) + ": face corner '" + corner +
-                           "' has no vertex index; expected v, v/vt, v//vn or v/vt/vn");
+        throw IoError(where + "face corner '" + corner + "' has no vertex index; expected v, v/vt, v//vn or v/vt/vn");
     }
   }
   if (ext == ".ply") throw IoError(file_message(path, "malformed PLY: the header has no 'end_header' line"));

@@ -84,8 +84,17 @@ std::string io_error_of(const std::string& path) {
 TEST(MeshIo, PlyHeaderWithoutEndHeaderIsIoErrorNotAHang) {
   const std::string path = test::make_temp_dir("mesh_io") + "/no_end.ply";
   write_text(path, test::read_text(RAYSIFT_SOURCE_DIR "/tests/fuzz/corpus/ply/timeout_no_end_header.ply"));
+  EXPECT_NE(io_error_of(path).find(path + ":5: malformed PLY header line"), std::string::npos) << io_error_of(path);
+  write_text(path, "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n");
   const std::string msg = io_error_of(path);
   EXPECT_NE(msg.find(path + ": malformed PLY: the header has no 'end_header'"), std::string::npos) << msg;
+}
+
+TEST(MeshIo, MalformedPlyHeaderLineIsIoErrorNotACrash) {
+  const std::string path = test::make_temp_dir("mesh_io") + "/bad_property.ply";
+  write_text(path, test::read_text(RAYSIFT_SOURCE_DIR "/tests/fuzz/corpus/ply/crash_malformed_property.ply"));
+  const std::string msg = io_error_of(path);
+  EXPECT_NE(msg.find(path + ":3: malformed PLY header line 'elemen 1.0e'"), std::string::npos) << msg;
 }
 
 TEST(MeshIo, ObjFaceCornerWithoutVertexIndexIsIoErrorNotAnAbort) {
