@@ -34,7 +34,7 @@ bool is_ply_header_line(const std::string& line) {
   std::string word, a, b, c, rest;
   if (!(in >> word)) return false;
   if (word == "comment" || word == "obj_info") return true;
-  if (word == "format") return (in >> a >> b) && !(in >> rest) &&
+  if (word == "format") return (in >> a >> b) && !(in >> rest) && b == "1.0" &&  // PLY has one version
                                (a == "ascii" || a == "binary_little_endian" || a == "binary_big_endian");
   if (word == "element") {
     long long count = -1;
