@@ -52,13 +52,16 @@ void reject_openmesh_traps(const std::string& path, const std::string& ext) {
   if (ext != ".ply" && ext != ".obj") return;
   std::ifstream in(path, std::ios::binary);
   std::string line;
+  bool seen_element = false;
   for (int number = 1; std::getline(in, line); ++number) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     const std::string where = path + ":" + std::to_string(number) + ": ";
     if (ext == ".ply") {
       if (line == "end_header") return;
-      if (number == 1 ? line != "ply" : !is_ply_header_line(line))
+      const bool is_property = line.rfind("property", 0) == 0;  // a property before any element segfaults OpenMesh
+      if (number == 1 ? line != "ply" : !is_ply_header_line(line) || (is_property && !seen_element))
         throw IoError(where + "malformed PLY header line '" + line.substr(0, 60) + "'");
+      seen_element = seen_element || line.rfind("element", 0) == 0;
       continue;
     }
     std::istringstream tokens(line);

@@ -95,6 +95,8 @@ TEST(MeshIo, MalformedPlyHeaderLineIsIoErrorNotACrash) {
   write_text(path, test::read_text(RAYSIFT_SOURCE_DIR "/tests/fuzz/corpus/ply/crash_malformed_property.ply"));
   const std::string msg = io_error_of(path);
   EXPECT_NE(msg.find(path + ":3: malformed PLY header line 'elemen 1.0e'"), std::string::npos) << msg;
+  write_text(path, test::read_text(RAYSIFT_SOURCE_DIR "/tests/fuzz/corpus/ply/crash_property_before_element.ply"));
+  EXPECT_NE(io_error_of(path).find(path + ":4: malformed PLY header line"), std::string::npos) << io_error_of(path);
   write_text(path, test::read_text(RAYSIFT_SOURCE_DIR "/tests/fuzz/corpus/ply/timeout_bad_version.ply"));
   EXPECT_NE(io_error_of(path).find(path + ":2: malformed PLY header line"), std::string::npos) << io_error_of(path);
 }
