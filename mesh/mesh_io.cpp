@@ -2,7 +2,11 @@
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <fstream>
+#include <sstream>
 
 #include "core/errors.h"
 #include "core/file_util.h"
@@ -16,6 +20,60 @@ void require_mesh_extension(const std::string& path) {
   const std::string ext = file_extension(path);
   if (ext != ".ply" && ext != ".obj" && ext != ".off")
     throw IoError(file_message(path, "unsupported mesh format '" + ext + "'; expected .ply, .obj or .off"));
+}
+
+bool is_ply_type(const std::string& t) {
+  static const char* types[] = {"char",  "uchar",  "short", "ushort", "int",   "uint",    "float",   "double",
+                                "int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
+  return std::any_of(std::begin(types), std::end(types), [&](const char* k) { return t == k; });
+}
+
+/// One PLY header line is well formed: OpenMesh 9's header parser reads past malformed ones (a crash, or a loop).
+bool is_ply_header_line(const std::string& line) {
+  std::istringstream in(line);
+  std::string word, a, b, c, rest;
+  if (!(in >> word)) return false;
+  if (word == "comment" || word == "obj_info") return true;
+  if (word == "format") return (in >> a >> b) && !(in >> rest) && b == "1.0" &&  // PLY has one version
+                               (a == "ascii" || a == "binary_little_endian" || a == "binary_big_endian");
+  if (word == "element") {
+    long long count = -1;
+    return (in >> a >> count) && count >= 0 && !(in >> rest);
+  }
+  if (word != "property" || !(in >> a >> b)) return false;
+  if (a != "list") return is_ply_type(a) && !(in >> rest);
+  return is_ply_type(b) && (in >> c) && is_ply_type(c) && (in >> rest) && !(in >> word);
+}
+
+/// Input that Debian's OpenMesh 9 does not survive, rejected before it gets there (found by tests/fuzz): a PLY
+/// header without `end_header` loops its reader forever and a malformed header line crashes it; an OBJ face
+/// corner without a vertex index ("f /1/1 ...") trips an assert that aborts the process.
+void reject_openmesh_traps(const std::string& path, const std::string& ext) {
+  if (ext != ".ply" && ext != ".obj") return;
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  bool seen_element = false;
+  for (int number = 1; std::getline(in, line); ++number) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const std::string where = path + ":" + std::to_string(number) + ": ";
+    if (ext == ".ply") {
+      if (line == "end_header") return;
+      const bool is_property = line.rfind("property", 0) == 0;  // a property before any element segfaults OpenMesh
+      if (number == 1 ? line != "ply" : !is_ply_header_line(line) || (is_property && !seen_element))
+        throw IoError(where + "malformed PLY header line '" + line.substr(0, 60) + "'");
+      seen_element = seen_element || line.rfind("element", 0) == 0;
+      continue;
+    }
+    std::istringstream tokens(line);
+    std::string word;
+    if (!(tokens >> word) || word != "f") continue;
+    for (std::string corner; tokens >> corner;) {
+      const std::size_t digit = corner[0] == '-' ? 1 : 0;
+      if (digit >= corner.size() || !std::isdigit(static_cast<unsigned char>(corner[digit])))
+        throw IoError(where + "face corner '" + corner + "' has no vertex index; expected v, v/vt, v//vn or v/vt/vn");
+    }
+  }
+  if (ext == ".ply") throw IoError(file_message(path, "malformed PLY: the header has no 'end_header' line"));
 }
 
 }  // namespace
@@ -35,6 +93,7 @@ void validate_mesh(const TriMesh& mesh, const std::string& what) {
 TriMesh read_mesh(const std::string& path, const MeshReadOptions& options) {
   require_readable_file(path);
   require_mesh_extension(path);
+  reject_openmesh_traps(path, file_extension(path));
   detail::OmPolyMesh poly;
   {
     detail::MuteOpenMeshLog mute;

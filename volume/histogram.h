@@ -10,10 +10,12 @@ namespace raysift::volume {
 
 /// `counts.size()` equal-width bins spanning [min, max]: bin b holds values in
 /// [min + b*w, min + (b+1)*w) with w = (max - min) / bins; the value max falls in the last bin.
-/// When min == max every voxel is in bin 0. The counts sum to the active voxel count.
+/// When min == max every voxel is in bin 0. NaN and +-Inf voxels are in no bin: they are counted in
+/// `non_finite`, so the counts plus non_finite sum to the active voxel count.
 struct Histogram {
-  double min = 0, max = 0;            ///< value range of the active voxels (0, 0 when empty)
+  double min = 0, max = 0;            ///< range of the finite active values (0, 0 when there are none)
   std::vector<std::uint64_t> counts;
+  std::uint64_t non_finite = 0;       ///< active voxels holding NaN or +-Inf
 
   double bin_width() const { return counts.empty() ? 0.0 : (max - min) / double(counts.size()); }
   /// Centre value of bin b.

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <future>
@@ -32,7 +34,9 @@ class MeshCli : public ::testing::Test {
 std::string MeshCli::dir_;
 
 TEST_F(MeshCli, WritesMeshAndStats) {
+  const auto start = std::chrono::steady_clock::now();
   const CliRun r = run_raysift(dir_, "mesh ball.vdb --iso 0.5 --smooth 5 --decimate 0.5 -o ball.ply --stats stats.json");
+  const double wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   ASSERT_EQ(r.code, 0) << r.err;
   ASSERT_TRUE(std::filesystem::exists(dir_ + "/ball.ply"));
   const Json s = read_json_file(dir_ + "/stats.json");
@@ -47,10 +51,20 @@ TEST_F(MeshCli, WritesMeshAndStats) {
   const Json& stages = s.at("stages");
   const auto mc = stages.at("marching_cubes").at("triangles").get<std::size_t>();
   EXPECT_EQ(stages.at("smooth_before").at("triangles").get<std::size_t>(), mc);
-  EXPECT_NEAR(double(stages.at("decimate").at("triangles").get<std::size_t>()), 0.5 * double(mc), 0.01 * double(mc));
+  // Without --max-error decimation reaches its target round(ratio * faces) or one below (mesh/decimation.h).
+  const auto target = std::size_t(std::llround(0.5 * double(mc)));
+  const auto decimated = stages.at("decimate").at("triangles").get<std::size_t>();
+  EXPECT_LE(decimated, target);
+  EXPECT_GE(decimated + 1, target);
   EXPECT_EQ(stages.at("smooth_after").at("triangles").get<std::size_t>(), surface.at("triangles").get<std::size_t>());
-  for (const char* stage : {"marching_cubes", "smooth_before", "decimate", "smooth_after"})
-    EXPECT_GE(stages.at(stage).at("ms").get<double>(), 0.0) << stage;
+  // The stages run one after another inside the process, so their times (ms, not s or us) fit in its wall time.
+  double stages_ms = 0;
+  for (const char* stage : {"marching_cubes", "smooth_before", "decimate", "smooth_after"}) {
+    const double ms = stages.at(stage).at("ms").get<double>();
+    EXPECT_GT(ms, 0.0) << stage;
+    stages_ms += ms;
+  }
+  EXPECT_LT(stages_ms, wall_ms);
 }
 
 TEST_F(MeshCli, TransferFunctionChoosesTheIsoValue) {

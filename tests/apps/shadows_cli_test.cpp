@@ -1,11 +1,13 @@
-// CLI tests for `raysift shadows`: stats keys, raytrace against itself has zero error, the EXR holds a visible
-// fraction in [0,1] with background 1, and bad input fails with the right code and no output.
+// CLI tests for `raysift shadows`: the ray-traced EXR against an analytic penumbra, the NRR error stats against
+// the two images they compare, and bad input failing with the right code and no output.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 
+#include "core/camera.h"
 #include "core/image.h"
 #include "core/json_io.h"
 #include "tests/support/test_support.h"
@@ -28,42 +30,101 @@ std::string make_blocks4_dir(const std::string& tag) {
   return dir;
 }
 
-TEST(ShadowsCli, RaytraceAgainstItselfHasZeroErrorAndAValidVisibilityImage) {
-  const std::string dir = make_blocks4_dir("shadows_cli");
-  const CliRun r = raysift(dir, "shadows b4.ply --light light.json --method raytrace --reference raytrace "
-                                "--light-samples 4 --width 48 --height 40 -o vis.exr --stats s.json");
-  ASSERT_EQ(r.code, 0) << r.err;
-  const Json s = read_json_file(dir + "/s.json");
-  EXPECT_EQ(s["visibility_error_avg"].get<double>(), 0.0);
-  EXPECT_EQ(s["intensity_error_avg"].get<double>(), 0.0);
-  EXPECT_EQ(s["intensity_error_max"].get<double>(), 0.0);
-  for (const char* key : {"depth_images", "reconstruction", "shadows"}) EXPECT_TRUE(s["times_ms"].contains(key)) << key;
+// An analytic soft shadow: a 2 x 2 square occluder at height kOccluderY over a ground plane, under a 2 x 2 light at
+// height 8 (light.json), seen from straight above. A ground point's visible fraction is the share of the N x N
+// light samples whose segment to it misses the square, computed here from the geometry alone.
+constexpr double kOccluderY = 2.0;
+constexpr int kSamplesPerSide = 4;
 
-  const ImageF vis = read_image_float(dir + "/vis.exr");
-  ASSERT_EQ(vis.width, 48);
-  ASSERT_EQ(vis.height, 40);
-  int shadowed = 0;
-  for (float v : vis.pixels) {
-    ASSERT_TRUE(std::isfinite(v));
-    ASSERT_GE(v, 0.0f);
-    ASSERT_LE(v, 1.0f);
-    shadowed += v < 1.0f;
-  }
-  EXPECT_GT(shadowed, 0) << "the blocks cast shadows on the ground";
+std::string make_penumbra_dir(const std::string& tag) {
+  const std::string dir = make_blocks4_dir(tag);
+  // Both quads face +y (counter-clockwise seen from above).
+  std::ofstream(dir + "/penumbra.obj") << "v -8 0 -8\nv -8 0 8\nv 8 0 8\nv 8 0 -8\n"
+                                          "v -1 2 -1\nv -1 2 1\nv 1 2 1\nv 1 2 -1\n"
+                                          "f 1 2 3\nf 1 3 4\nf 5 6 7\nf 5 7 8\n";
+  std::ofstream(dir + "/top.json") << R"({"eye": [0, 10, 0], "target": [0, 0, 0], "up": [0, 0, -1], "fov_y_deg": 50,
+                                          "width": 48, "height": 40})";
+  return dir;
 }
 
-TEST(ShadowsCli, NrrReportsErrorsAgainstTheReference) {
-  const std::string dir = make_blocks4_dir("shadows_cli_nrr");
-  const CliRun r = raysift(dir, "shadows b4.ply --light light.json --method nrr --light-samples 4 --resolution 64 "
-                                "--width 48 --height 40 -o shaded.png --error-map err.png --stats s.json");
-  ASSERT_EQ(r.code, 0) << r.err;
-  const Json s = read_json_file(dir + "/s.json");
-  const double avg = s["intensity_error_avg"].get<double>();
-  EXPECT_GE(avg, 0.0);
-  EXPECT_LE(avg, s["intensity_error_max"].get<double>());
-  EXPECT_LE(s["intensity_error_max"].get<double>(), 255.0);
-  EXPECT_TRUE(fs::exists(dir + "/shaded.png"));
+/// Distance of (x, z) outside the occluder square [-1, 1]^2 (negative inside): its sign decides blocking, its
+/// magnitude whether float rounding and the tracer's origin offset may flip the answer.
+double square_margin(double x, double z) { return std::max(std::abs(x), std::abs(z)) - 1.0; }
+
+struct AnalyticPixel {
+  double fraction = 1;
+  bool ambiguous = false;  ///< a ray passes within kEdge of the occluder's outline
+};
+
+AnalyticPixel analytic_visibility(const Camera& cam, int x, int y) {
+  constexpr double kEdge = 1e-4;  // world units: far above float rounding at this scale (~1e-6)
+  AnalyticPixel out;
+  const Ray eye_ray = cam.ray(x + 0.5, y + 0.5);
+  const Vec3d top = eye_ray.origin + eye_ray.direction * ((kOccluderY - eye_ray.origin.y) / eye_ray.direction.y);
+  const double top_margin = square_margin(top.x, top.z);
+  out.ambiguous = std::abs(top_margin) < kEdge;
+  if (top_margin < 0) return out;  // the eye sees the occluder's top: nothing above it but the light
+  const Vec3d ground = eye_ray.origin + eye_ray.direction * (-eye_ray.origin.y / eye_ray.direction.y);
+  int visible = 0;
+  for (int k = 0; k < kSamplesPerSide; ++k)
+    for (int m = 0; m < kSamplesPerSide; ++m) {
+      const Vec3d sample{-1 + 2 * (m + 0.5) / kSamplesPerSide, 8, -1 + 2 * (k + 0.5) / kSamplesPerSide};
+      const Vec3d cross = ground + (sample - ground) * (kOccluderY / sample.y);
+      const double margin = square_margin(cross.x, cross.z);
+      out.ambiguous = out.ambiguous || std::abs(margin) < kEdge;
+      visible += margin > 0;
+    }
+  out.fraction = double(visible) / (kSamplesPerSide * kSamplesPerSide);
+  return out;
+}
+
+TEST(ShadowsCli, RaytraceMatchesTheAnalyticPenumbraAndNrrErrorsAreItsMeanDifference) {
+  const std::string dir = make_penumbra_dir("shadows_cli");
+  const std::string common = "shadows penumbra.obj --light light.json --camera top.json --light-samples " +
+                             std::to_string(kSamplesPerSide) + " --resolution 128 --reference raytrace ";
+  const auto runs = test::run_cli_all(RAYSIFT_EXE, dir,
+                                      {common + "--method raytrace -o rt.exr --stats rt.json",
+                                       common + "--method nrr -o nrr.exr --error-map err.png --stats nrr.json"});
+  for (const CliRun& r : runs) ASSERT_EQ(r.code, 0) << r.err;
+
+  const Camera cam(camera_spec_from_json(read_json_file(dir + "/top.json"), "top.json"));
+  const ImageF rt = read_image_float(dir + "/rt.exr");
+  ASSERT_EQ(rt.width, 48);
+  ASSERT_EQ(rt.height, 40);
+  int ambiguous = 0, penumbra = 0;
+  for (int y = 0; y < rt.height; ++y)
+    for (int x = 0; x < rt.width; ++x) {
+      const AnalyticPixel a = analytic_visibility(cam, x, y);
+      if (a.ambiguous) {
+        ++ambiguous;
+        continue;
+      }
+      penumbra += a.fraction > 0 && a.fraction < 1;
+      // k / N^2 is exact in float, so the ray-traced fraction must equal it exactly.
+      EXPECT_EQ(rt(x, y), float(a.fraction)) << "pixel " << x << "," << y;
+    }
+  EXPECT_LE(ambiguous, rt.width * rt.height / 50) << "too few pixels checked";
+  EXPECT_GT(penumbra, 20) << "the view must hold a real penumbra";
+
+  // Every pixel sees the ground or the occluder, so all count; the intensity error of a pixel is
+  // 255 |f_nrr - f_raytrace| (nrr/shadow_errors.h).
+  const Json s = read_json_file(dir + "/nrr.json");
+  const ImageF nrr = read_image_float(dir + "/nrr.exr");
+  ASSERT_EQ(s.at("counted_pixels").get<std::size_t>(), rt.pixels.size());
+  double sum = 0, worst = 0;
+  for (std::size_t p = 0; p < rt.pixels.size(); ++p) {
+    const double e = 255.0 * std::abs(double(nrr.pixels[p]) - double(rt.pixels[p]));
+    sum += e;
+    worst = std::max(worst, e);
+  }
+  // Each |difference| is k / N^2 computed in float from exact values: 1e-9 covers the double sums' rounding.
+  EXPECT_NEAR(s.at("intensity_error_avg").get<double>(), sum / double(rt.pixels.size()), 1e-9);
+  EXPECT_NEAR(s.at("intensity_error_max").get<double>(), worst, 1e-9);
+  // Per pixel |sum of errors| <= sum of |errors|.
+  EXPECT_GE(s.at("visibility_error_avg").get<double>(), s.at("intensity_error_avg").get<double>());
   EXPECT_TRUE(fs::exists(dir + "/err.png"));
+  for (const char* key : {"depth_images", "reconstruction", "shadows"})
+    EXPECT_TRUE(s.at("times_ms").contains(key)) << key;
 }
 
 TEST(ShadowsCli, BadInputFailsWithTheRightCodeAndNoOutput) {

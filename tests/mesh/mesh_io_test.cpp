@@ -70,6 +70,47 @@ TEST(MeshIo, MalformedFileIsIoError) {
   EXPECT_THROW(read_mesh(path), IoError);
 }
 
+// Regression tests for two fuzz findings (tests/fuzz/corpus/{ply,obj}): before the pre-check, the first input hung
+// OpenMesh's PLY reader forever and the second aborted the process in an OpenMesh assert.
+std::string io_error_of(const std::string& path) {
+  try {
+    read_mesh(path);
+  } catch (const IoError& e) {
+    return e.what();
+  }
+  return "no IoError";
+}
+
+TEST(MeshIo, PlyHeaderWithoutEndHeaderIsIoErrorNotAHang) {
+  const std::string path = test::make_temp_dir("mesh_io") + "/no_end.ply";
+  write_text(path, test::read_text(RAYSIFT_SOURCE_DIR "/tests/fuzz/corpus/ply/timeout_no_end_header.ply"));
+  EXPECT_NE(io_error_of(path).find(path + ":5: malformed PLY header line"), std::string::npos) << io_error_of(path);
+  write_text(path, "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n");
+  const std::string msg = io_error_of(path);
+  EXPECT_NE(msg.find(path + ": malformed PLY: the header has no 'end_header'"), std::string::npos) << msg;
+}
+
+TEST(MeshIo, MalformedPlyHeaderLineIsIoErrorNotACrash) {
+  const std::string path = test::make_temp_dir("mesh_io") + "/bad_property.ply";
+  write_text(path, test::read_text(RAYSIFT_SOURCE_DIR "/tests/fuzz/corpus/ply/crash_malformed_property.ply"));
+  const std::string msg = io_error_of(path);
+  EXPECT_NE(msg.find(path + ":3: malformed PLY header line 'elemen 1.0e'"), std::string::npos) << msg;
+  write_text(path, test::read_text(RAYSIFT_SOURCE_DIR "/tests/fuzz/corpus/ply/crash_property_before_element.ply"));
+  EXPECT_NE(io_error_of(path).find(path + ":4: malformed PLY header line"), std::string::npos) << io_error_of(path);
+  write_text(path, test::read_text(RAYSIFT_SOURCE_DIR "/tests/fuzz/corpus/ply/timeout_bad_version.ply"));
+  EXPECT_NE(io_error_of(path).find(path + ":2: malformed PLY header line"), std::string::npos) << io_error_of(path);
+}
+
+TEST(MeshIo, ObjFaceCornerWithoutVertexIndexIsIoErrorNotAnAbort) {
+  const std::string path = test::make_temp_dir("mesh_io") + "/corner.obj";
+  write_text(path, test::read_text(RAYSIFT_SOURCE_DIR "/tests/fuzz/corpus/obj/crash_corner_without_vertex.obj"));
+  const std::string msg = io_error_of(path);
+  EXPECT_NE(msg.find(path + ":1: face corner '/1/1'"), std::string::npos) << msg;
+  // Negative (relative) indices and all slash forms stay valid.
+  write_text(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf -3/1/1 -2//1 -1/1\n");
+  EXPECT_EQ(read_mesh(path).triangle_count(), 1u);
+}
+
 TEST(MeshIo, FileWithoutFacesIsInvalidInput) {
   const std::string path = test::make_temp_dir("mesh_io") + "/points.off";
   write_text(path, "OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n");

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 
 #include "core/errors.h"
@@ -31,28 +32,47 @@ TEST(IntermediateViews, SegmentPointsAreEvenlySpacedCellCentres) {
   }
 }
 
-TEST(IntermediateViews, TriangleAndQuadPointsCoverTheRegionUniformly) {
-  const std::vector<CameraSpec> tri = {at({0, 0, 5}), at({6, 0, 5}), at({0, 6, 5})};
+/// Pearson's chi-square statistic of `counts` against equal expected counts.
+double chi_square_uniform(const std::vector<int>& counts, int n) {
+  const double expected = double(n) / double(counts.size());
+  double chi2 = 0;
+  for (int c : counts) chi2 += (c - expected) * (c - expected) / expected;
+  return chi2;
+}
+
+// Chi-square goodness of fit against the uniform density: each region is cut into 16 cells of equal area, so
+// every cell expects n/16 eyes. 37.70 is the 0.999 quantile of chi-square with 15 degrees of freedom, the bound
+// a truly random uniform sampler would exceed once in a thousand runs; the Hammersley points (deterministic, low
+// discrepancy) sit far below it. A non-area-preserving map fails it: with the triangle's sqrt dropped, eyes crowd
+// toward the first view and chi-square is about 700.
+TEST(IntermediateViews, TriangleAndQuadPointsPassAChiSquareUniformityTest) {
+  constexpr double kChi2Df15P999 = 37.70;
   const int n = 1024;
-  const auto frames = intermediate_views(Span<const CameraSpec>(tri), n);
-  Vec3d mean;
-  for (const CameraSpec& f : frames) {
+  const std::vector<CameraSpec> tri = {at({0, 0, 5}), at({6, 0, 5}), at({0, 6, 5})};
+  // The triangle in a 4 x 4 grid of barycentric steps: 10 upright and 6 inverted sub-triangles, all congruent.
+  std::vector<int> tri_cells(16, 0);
+  for (const CameraSpec& f : intermediate_views(Span<const CameraSpec>(tri), n)) {
     ASSERT_GE(f.eye.x, -1e-12);
     ASSERT_GE(f.eye.y, -1e-12);
     ASSERT_LE(f.eye.x + f.eye.y, 6.0 + 1e-12);  // inside the triangle
-    mean += f.eye / double(n);
+    const double u = std::min(f.eye.x / 6.0 * 4.0, 4.0 - 1e-9), v = std::min(f.eye.y / 6.0 * 4.0, 4.0 - 1e-9);
+    const int i = int(u), j = int(v);
+    const bool upright = (u - i) + (v - j) < 1.0;
+    // Upright cells (i, j) with i + j <= 3 take slots 0..9, inverted ones with i + j <= 2 slots 10..15.
+    const int slot = upright ? j * 4 - j * (j - 1) / 2 + i : 10 + j * 3 - j * (j - 1) / 2 + i;
+    ASSERT_LT(slot, 16) << f.eye.x << ", " << f.eye.y;
+    ++tri_cells[std::size_t(slot)];
   }
-  // Uniform density: the mean is the centroid (2, 2); Hammersley points err by O(log n / n).
-  EXPECT_NEAR(mean.x, 2.0, 0.02);
-  EXPECT_NEAR(mean.y, 2.0, 0.02);
+  EXPECT_LT(chi_square_uniform(tri_cells, n), kChi2Df15P999);
+  // The rectangle 4 x 2 (its bilinear patch is affine, so uniform maps to uniform) in a 4 x 4 grid of cells.
   const std::vector<CameraSpec> quad = {at({0, 0, 5}), at({4, 0, 5}), at({4, 2, 5}), at({0, 2, 5})};
-  Vec3d qmean;
+  std::vector<int> quad_cells(16, 0);
   for (const CameraSpec& f : intermediate_views(Span<const CameraSpec>(quad), n)) {
     ASSERT_TRUE(f.eye.x >= 0 && f.eye.x <= 4 && f.eye.y >= 0 && f.eye.y <= 2);
-    qmean += f.eye / double(n);
+    const int i = std::min(int(f.eye.x), 3), j = std::min(int(f.eye.y * 2), 3);
+    ++quad_cells[std::size_t(j * 4 + i)];
   }
-  EXPECT_NEAR(qmean.x, 2.0, 0.02);
-  EXPECT_NEAR(qmean.y, 1.0, 0.02);
+  EXPECT_LT(chi_square_uniform(quad_cells, n), kChi2Df15P999);
 }
 
 TEST(IntermediateViews, BadInputThrows) {

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "core/errors.h"
 #include "core/image.h"
@@ -55,8 +56,31 @@ TEST(CameraPath, ReadsListsAndOrbits) {
   ASSERT_EQ(orbit.size(), 5u);
   EXPECT_EQ(orbit[3].width, 96);
   EXPECT_NEAR(length(orbit[3].eye), 10.0, 1e-12);
-  EXPECT_TRUE(same_camera(orbit[0], orbit[0]));
   EXPECT_FALSE(same_camera(orbit[0], orbit[1]));
+}
+
+// same_camera decides whether a path frame refines the previous one: equal for an independently built camera with
+// the same fields, unequal when any single field differs.
+TEST(CameraPath, SameCameraComparesEveryField) {
+  const Json fields = Json::parse(R"({"eye": [1, 2, 3], "target": [0, 1, 0], "up": [0, 0, 1], "fov_y_deg": 35,
+                                      "width": 64, "height": 48})");
+  const CameraSpec parsed = camera_path_from_json(Json::array({fields}), "p.json").at(0);
+  CameraSpec built;
+  built.eye = {1, 2, 3};
+  built.target = {0, 1, 0};
+  built.up = {0, 0, 1};
+  built.fov_y_deg = 35;
+  built.width = 64;
+  built.height = 48;
+  EXPECT_TRUE(same_camera(parsed, built));
+  std::vector<CameraSpec> changed(6, built);
+  changed[0].eye.z += 1e-9;
+  changed[1].target.x = -1;
+  changed[2].up = {0, 1, 1};
+  changed[3].fov_y_deg = 36;
+  changed[4].width = 65;
+  changed[5].height = 47;
+  for (std::size_t i = 0; i < changed.size(); ++i) EXPECT_FALSE(same_camera(parsed, changed[i])) << "field " << i;
 }
 
 TEST(CameraPath, RejectsBadPaths) {

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "core/errors.h"
@@ -37,6 +39,28 @@ TEST(Histogram, EqualWidthBinsOnKnownValues) {
   EXPECT_EQ(h.counts, (std::vector<std::uint64_t>{2, 2, 2, 2}));
   EXPECT_DOUBLE_EQ(h.bin_width(), 1.75);
   EXPECT_DOUBLE_EQ(h.bin_center(0), 1.875);
+}
+
+// from_function stores whatever the function returns; NaN and Inf must neither become a bin index (undefined
+// behaviour, caught by the sanitizer job) nor stretch the range.
+TEST(Histogram, NonFiniteVoxelsCountedApartFromTheFiniteRange) {
+  DenseSpec spec;
+  spec.dims = {7, 1, 1};
+  const float values[7] = {std::nanf(""), 2, 3, std::numeric_limits<float>::infinity(), 4, 5,
+                           -std::numeric_limits<float>::infinity()};
+  const Volume v = Volume::from_function(spec, [&](int i, int, int) { return values[i]; });
+  const Histogram h = compute_histogram(v, 3);
+  EXPECT_EQ(h.min, 2.0);
+  EXPECT_EQ(h.max, 5.0);
+  // Width 1: {2} {3} {4, 5}; 5 == max is clamped into the last bin.
+  EXPECT_EQ(h.counts, (std::vector<std::uint64_t>{1, 1, 2}));
+  EXPECT_EQ(h.non_finite, 3u);
+  const Volume all_nan = Volume::from_function(spec, [](int, int, int) { return std::nanf(""); });
+  const Histogram n = compute_histogram(all_nan, 3);
+  EXPECT_EQ(total(n), 0u);
+  EXPECT_EQ(n.non_finite, 7u);
+  EXPECT_EQ(n.min, 0.0);
+  EXPECT_EQ(n.max, 0.0);
 }
 
 TEST(Histogram, ConstantAndEmptyVolumes) {

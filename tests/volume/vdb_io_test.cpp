@@ -1,7 +1,10 @@
 #include "volume/vdb_io.h"
 
 #include <gtest/gtest.h>
+#include <zlib.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -210,6 +213,58 @@ TEST(VdbIo, BundledDatasetsMatchTheirReadme) {
   EXPECT_EQ(head[0].active_voxels, 1193707u);
   EXPECT_EQ(head[0].value_max, 202.0);
   EXPECT_EQ(head[0].bbox_max, Vec3d(127, 127, 83));
+}
+
+/// What the bundled grids should hold, counted straight from the gzipped raw source with zlib (no raysift code):
+/// nonzero bytes become active voxels (README: imported with --tolerance 0, background 0).
+struct RawCounts {
+  std::uint64_t nonzero = 0;
+  int min = 256, max = -1;
+  Vec3i hi{-1, -1, -1};  ///< largest index with a nonzero voxel on each axis
+};
+
+RawCounts count_raw_u8(const std::string& path, const Vec3i& dims) {
+  RawCounts c;
+  gzFile f = gzopen(path.c_str(), "rb");
+  if (!f) return c;
+  std::vector<unsigned char> slice(std::size_t(dims.x) * std::size_t(dims.y));
+  for (int z = 0; z < dims.z; ++z) {
+    if (gzread(f, slice.data(), unsigned(slice.size())) != int(slice.size())) break;
+    for (std::size_t i = 0; i < slice.size(); ++i) {
+      if (!slice[i]) continue;
+      ++c.nonzero;
+      c.min = std::min<int>(c.min, slice[i]);
+      c.max = std::max<int>(c.max, slice[i]);
+      c.hi = {std::max(c.hi.x, int(i % std::size_t(dims.x))), std::max(c.hi.y, int(i / std::size_t(dims.x))),
+              std::max(c.hi.z, z)};
+    }
+  }
+  gzclose(f);
+  return c;
+}
+
+// The shared raw sources sit beside the repository ($RAYSIFT_SHARED_DATASETS overrides, as for the benches).
+TEST(VdbIo, BundledDatasetsMatchACountOfTheirRawSources) {
+  const char* env = std::getenv("RAYSIFT_SHARED_DATASETS");
+  const std::string shared = env && *env ? env : std::string(RAYSIFT_SOURCE_DIR) + "/../shared/datasets";
+  struct Dataset {
+    const char* vdb;
+    const char* raw;
+    Vec3i dims;
+  };
+  for (const Dataset& d : {Dataset{"engine_ct.vdb", "engine_ct_256x256x128_u8.raw.gz", {256, 256, 128}},
+                           Dataset{"mri_head.vdb", "mri_head_unc_brainsmall_128x128x84_u8.raw.gz", {128, 128, 84}}}) {
+    const std::string raw = shared + "/" + d.raw;
+    if (!std::filesystem::exists(raw)) GTEST_SKIP() << raw << " is not available";
+    const RawCounts c = count_raw_u8(raw, d.dims);
+    ASSERT_GT(c.nonzero, 0u) << raw;
+    const std::vector<GridInfo> grids = inspect_vdb(std::string(RAYSIFT_SOURCE_DIR) + "/datasets/" + d.vdb);
+    ASSERT_EQ(grids.size(), 1u);
+    EXPECT_EQ(grids[0].active_voxels, c.nonzero) << d.vdb;
+    EXPECT_EQ(grids[0].value_min, double(c.min)) << d.vdb;
+    EXPECT_EQ(grids[0].value_max, double(c.max)) << d.vdb;
+    EXPECT_EQ(grids[0].index_max, c.hi) << d.vdb;
+  }
 }
 
 TEST(VdbIo, SaveIsAtomicOnFailure) {
