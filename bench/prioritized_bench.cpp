@@ -10,7 +10,7 @@
 // Scenes: engine CT opaque and translucent (second view), MRI head opaque and translucent, and with --unseen
 // the smoke VDB from the shared datasets (bench/bench_data.h) with a TF written once (normalised to its value range) and never tuned.
 // Usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--linear] [--floor F] [--line-weight W]
-//                          [--alpha a00,...,a02] [--budget-frames N]
+//                          [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -111,6 +111,7 @@ struct Setup {
   sampling::SamplingOptions sampling;  ///< alpha, refinement; mode/fraction/budget set per row
   sampling::FeatureOptions features;
   int budget_frames = 10;
+  int overhead_only = 0;  ///< > 0: only the overhead table, repeated this many times (for a profiler)
 };
 
 struct Scene {
@@ -268,7 +269,9 @@ void run_scene(const Scene& sc, const Setup& setup, int width, int height, bool 
   volume::RenderOptions render;
   render.shading = volume::Shading::Phong;
   SceneRun run(sc, setup, cam, render);
+  for (int k = 1; k < setup.overhead_only; ++k) run.overhead();
   run.overhead();
+  if (setup.overhead_only > 0) return;
   run.subsample_curve();
   run.equal_time();
   run.equal_rays();
@@ -301,9 +304,10 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--scenes") && more) scenes = argv[++i];
     else if (!std::strcmp(argv[i], "--alpha") && more) setup.sampling.mapping = sampling::parse_priority_mapping(argv[++i]);
     else if (!std::strcmp(argv[i], "--budget-frames") && more) setup.budget_frames = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--overhead-only") && more) setup.overhead_only = std::atoi(argv[++i]);
     else {
       std::fprintf(stderr, "usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--linear] [--floor F] "
-                           "[--line-weight W] [--alpha a00,...,a02] [--budget-frames N]\n");
+                           "[--line-weight W] [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N]\n");
       return 2;
     }
   }
