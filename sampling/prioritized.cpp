@@ -12,13 +12,37 @@
 namespace raysift::sampling {
 namespace {
 
-void require_finite_importance(const ImageF& importance) {
+// Per row: object and level-0 object pixels, and the first non-finite value (x, or -1). One parallel pass
+// for the check and the counts, which every frame needs.
+struct RowScan {
+  std::size_t object = 0, level0 = 0;
+  int bad_x = -1;
+};
+
+// \throw InvalidInput naming the first (row-major) NaN/Inf pixel. \return the counts for `spacing`.
+ObjectCounts scan_importance(const ImageF& importance, int spacing) {
   if (importance.width < 1 || importance.height < 1) throw InvalidInput("importance buffer is empty (0x0)");
-  for (std::size_t i = 0; i < importance.size(); ++i)
-    if (!std::isfinite(importance.pixels[i]))
-      throw InvalidInput("importance buffer has a NaN/Inf value at pixel (" +
-                         std::to_string(i % std::size_t(importance.width)) + "," +
-                         std::to_string(i / std::size_t(importance.width)) + ")");
+  std::vector<RowScan> rows(std::size_t(importance.height));
+  const int lattice = spacing - 1;  // validate(): a power of two
+  parallel_rows(importance.height, [&](int y) {
+    const float* row = &importance.pixels[std::size_t(y) * std::size_t(importance.width)];
+    RowScan& r = rows[std::size_t(y)];
+    for (int x = 0; x < importance.width; ++x) {
+      if (!std::isfinite(row[x]) && r.bad_x < 0) r.bad_x = x;
+      r.object += row[x] >= 0 ? 1 : 0;
+    }
+    if ((y & lattice) == 0)
+      for (int x = 0; x < importance.width; x += spacing) r.level0 += row[x] >= 0 ? 1 : 0;
+  });
+  ObjectCounts c;
+  for (std::size_t y = 0; y < rows.size(); ++y) {
+    if (rows[y].bad_x >= 0)
+      throw InvalidInput("importance buffer has a NaN/Inf value at pixel (" + std::to_string(rows[y].bad_x) + "," +
+                         std::to_string(y) + ")");
+    c.object += rows[y].object;
+    c.level0 += rows[y].level0;
+  }
+  return c;
 }
 
 // Background or (with `traced`) traced pixels: what the reconstruction must not change.
@@ -59,22 +83,6 @@ void trace_selection(const ImageMask& selected, const TraceBatch& trace, Sampled
   frame.trace_ms = stage.elapsed_ms();
   mark(rays, frame.traced);
   frame.rays_traced = rays.size();
-}
-
-// The counts without building the pattern (the subsample and full modes do not need it).
-ObjectCounts count_object_pixels(const ImageF& importance, int spacing) {
-  ObjectCounts c;
-  const int mask = spacing - 1;  // validate(): a power of two
-  for (int y = 0; y < importance.height; ++y) {
-    const float* row = &importance.pixels[std::size_t(y) * std::size_t(importance.width)];
-    std::size_t object = 0, level0 = 0;
-    for (int x = 0; x < importance.width; ++x) object += row[x] >= 0 ? 1 : 0;
-    if ((y & mask) == 0)
-      for (int x = 0; x < importance.width; x += spacing) level0 += row[x] >= 0 ? 1 : 0;
-    c.object += object;
-    c.level0 += level0;
-  }
-  return c;
 }
 
 std::size_t ray_target(const SamplingOptions& options, std::size_t object, std::size_t level0) {
@@ -188,7 +196,7 @@ double estimate_reconstruct_ms(int width, int height, int base_spacing) {
 SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, const SamplingOptions& options,
                             double elapsed_before_ms) {
   validate(options);
-  require_finite_importance(importance);
+  const ObjectCounts counts = scan_importance(importance, options.base_spacing);
   const Timer clock;
   const ElapsedMs now = options.clock_ms ? options.clock_ms : ElapsedMs([&clock] { return clock.elapsed_ms(); });
   const int w = importance.width, h = importance.height;
@@ -197,7 +205,6 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
   frame.traced = ImageMask(w, h, 0);
 
   Timer stage;
-  const ObjectCounts counts = count_object_pixels(importance, options.base_spacing);
   frame.full_rays = counts.object;
   frame.level0_rays = counts.level0;
   const std::size_t target = ray_target(options, counts.object, counts.level0);
@@ -245,7 +252,7 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
 
 ProgressiveSampler::ProgressiveSampler(const ImageF& importance, const SamplingOptions& options) : options_(options) {
   validate(options);
-  require_finite_importance(importance);
+  scan_importance(importance, options.base_spacing);
   if (options.mode != SamplingMode::Prioritized)
     throw InvalidInput("--progressive needs --mode prioritized, got " + std::string(sampling_mode_name(options.mode)));
   const Timer timer;
