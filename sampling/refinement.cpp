@@ -182,11 +182,21 @@ class Refiner {
       : imp_(importance), pattern_(pattern), options_(options), image_(image), traced_(traced),
         cells_(frame_buffer<Cell>(importance.width, importance.height)), epoch_(next_epoch(cells_)),
         state_(frame_buffer<std::uint8_t>(importance.width, importance.height)), queue_(seed) {
-    parallel_rows(imp_.height, [this](int y) {
-      const std::size_t row = std::size_t(y) * std::size_t(imp_.width);
-      for (std::size_t i = row; i < row + std::size_t(imp_.width); ++i)
-        state_.pixels[i] = imp_.pixels[i] < 0 ? kKnown | kBackground : traced_.pixels[i] ? kKnown : 0;
+    // One pass per row of S x S blocks: the state mask and which blocks hold background.
+    const int s = pattern_.base_spacing, bw = (imp_.width + s - 1) / s, bh = (imp_.height + s - 1) / s;
+    Image<std::uint8_t> has_background(bw, bh, 0);
+    parallel_rows(bh, [&](int by) {
+      for (int y = by * s; y < std::min(imp_.height, (by + 1) * s); ++y) {
+        const std::size_t row = std::size_t(y) * std::size_t(imp_.width);
+        for (int x = 0; x < imp_.width; ++x) {
+          const std::size_t i = row + std::size_t(x);
+          const bool background = imp_.pixels[i] < 0;
+          state_.pixels[i] = background ? kKnown | kBackground : traced_.pixels[i] ? kKnown : 0;
+          if (background) has_background(x / s, by) = 1;
+        }
+      }
     });
+    mark_open_blocks(has_background);
     for (int l = 0; l < int(level_share_.size()); ++l) level_share_[l] = std::ldexp(1.0f, -l);
   }
 
@@ -252,10 +262,29 @@ class Refiner {
                               code(std::sqrt(std::max(0.0f, c.b))), code(c.a)};
   }
 
-  // After `pixel` was traced: the children it may have completed, at every finer level.
+  // open_(bx, by) = 1 where the S x S blocks around block (bx, by) hold background (`has`) or reach past the
+  // image: the only places where a corner can be known without being traced.
+  void mark_open_blocks(const Image<std::uint8_t>& has) {
+    const int bw = has.width, bh = has.height;
+    open_ = Image<std::uint8_t>(bw, bh, 0);
+    for (int by = 0; by < bh; ++by)
+      for (int bx = 0; bx < bw; ++bx) {
+        bool open = false;
+        for (int j = by - 1; j <= by + 1; ++j)
+          for (int i = bx - 1; i <= bx + 1; ++i) open = open || i < 0 || j < 0 || i >= bw || j >= bh || has(i, j);
+        open_(bx, by) = open ? 1 : 0;
+      }
+  }
+
+  // After `pixel` was traced: the children it may have completed, at every finer level. A child three or more
+  // levels finer has corners finer than `pixel`, which were traced after it (a pixel is only a candidate once its
+  // corners are known), unless a corner is background or outside the image: only open blocks ask beyond lq + 2.
   void children(std::uint32_t pixel, std::vector<Ready>& ready) const {
     const int w = imp_.width, qx = int(pixel % std::uint32_t(w)), qy = int(pixel / std::uint32_t(w));
-    for (int level = fractal_level(qx, qy, pattern_.base_spacing) + 1; level < pattern_.num_levels; ++level)
+    const int lq = fractal_level(qx, qy, pattern_.base_spacing);
+    const bool open = open_(qx / pattern_.base_spacing, qy / pattern_.base_spacing) != 0;
+    const int end = open ? pattern_.num_levels : std::min(pattern_.num_levels, lq + 3);
+    for (int level = lq + 1; level < end; ++level)
       for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
         const int x = qx - o[0], y = qy - o[1];
         if (x >= 0 && y >= 0 && x < w && y < imp_.height && fractal_level(x, y, pattern_.base_spacing) == level)
@@ -347,6 +376,7 @@ class Refiner {
   static constexpr std::uint8_t kKnown = 1, kTaken = 2, kBackground = 4;
   ImageMask& state_;  ///< kKnown: background or traced (kBackground: background); kTaken: popped for tracing
   BucketQueue queue_;
+  Image<std::uint8_t> open_;  ///< per S x S block, see mark_open_blocks()
   std::array<float, 16> level_share_;  ///< 2^-level, the share of the frame one ray of a level covers
 };
 
