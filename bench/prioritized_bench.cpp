@@ -10,7 +10,7 @@
 // Scenes: engine CT opaque and translucent (second view), MRI head opaque and translucent, and with --unseen
 // the smoke VDB from the shared datasets (bench/bench_data.h) with a TF written once (normalised to its value range) and never tuned.
 // Usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--linear] [--floor F] [--line-weight W]
-//                          [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N]
+//                          [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N] [--budget-only] [--spacing S]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -113,6 +113,7 @@ struct Setup {
   sampling::FeatureOptions features;
   int budget_frames = 10;
   int overhead_only = 0;  ///< > 0: only the overhead table, repeated this many times (for a profiler)
+  bool budget_only = false;  ///< only the budget table (engine opaque)
 };
 
 struct Scene {
@@ -254,15 +255,16 @@ struct SceneRun {
       sampling::SamplingOptions s = setup.sampling;
       s.budget_ms = share * full_ms;
       std::vector<double> times;
-      double rays = 0, reserve = -1;
+      double rays = 0;
+      sampling::BudgetReserve reserve;  // learned from the previous frames of this budget
       int level0_only = 0;
       for (int k = 0; k < setup.budget_frames; ++k) {
-        s.reconstruct_reserve_ms = reserve;  // the previous frame's measured reconstruction (x1.25), as in RP §5
+        s.reconstruct_reserve_ms = reserve.next_ms();
         const sampling::VolumeFrame f = sampling::render_volume_frame(caster, &geometry, setup.features, s);
         times.push_back(f.total_ms);
         rays += double(f.sampled.rays_traced);
         level0_only += f.sampled.budget_too_small;
-        reserve = 1.25 * f.sampled.reconstruct_ms;
+        reserve.update(f.total_ms - f.importance_ms - f.sampled.trace_end_ms, f.total_ms, s.budget_ms);
       }
       const double p95 = percentile(times, 0.95);
       std::printf("  %3.0f%% of full %8.0f %6.0f %6.0f %8.3f %9.0f %d\n", share * 100, s.budget_ms,
@@ -281,6 +283,10 @@ void run_scene(const Scene& sc, const Setup& setup, int width, int height, bool 
   for (int k = 1; k < setup.overhead_only; ++k) run.overhead();
   run.overhead();
   if (setup.overhead_only > 0) return;
+  if (setup.budget_only) {
+    if (budget_table) run.budget_table();
+    return;
+  }
   run.subsample_curve();
   run.equal_time();
   run.equal_rays();
@@ -314,9 +320,11 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--alpha") && more) setup.sampling.mapping = sampling::parse_priority_mapping(argv[++i]);
     else if (!std::strcmp(argv[i], "--budget-frames") && more) setup.budget_frames = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--overhead-only") && more) setup.overhead_only = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--budget-only")) setup.budget_only = true;
+    else if (!std::strcmp(argv[i], "--spacing") && more) setup.sampling.base_spacing = std::atoi(argv[++i]);
     else {
       std::fprintf(stderr, "usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--linear] [--floor F] "
-                           "[--line-weight W] [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N]\n");
+                           "[--line-weight W] [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N] [--budget-only] [--spacing S]\n");
       return 2;
     }
   }
@@ -324,11 +332,11 @@ int main(int argc, char** argv) {
   const int width = quick ? 720 : 1440, height = quick ? 450 : 900;
   const auto& a = setup.sampling.mapping.alpha;
   std::printf("prioritized_bench: %dx%d, phong, contours+silhouettes, %s reconstruction, refinement %s (floor %g, "
-              "line weight %g), alpha %g,%g,%g,%g,%g,%g\n", width, height,
+              "line weight %g), alpha %g,%g,%g,%g,%g,%g, base spacing %d\n", width, height,
               setup.sampling.interpolation == sampling::Interpolation::Cubic ? "cubic" : "linear",
               setup.sampling.refinement.enabled ? "on" : "off",
               setup.sampling.refinement.floor, setup.sampling.refinement.line_weight, a[0], a[1], a[2], a[3], a[4],
-              a[5]);
+              a[5], setup.sampling.base_spacing);
   const std::string dir = std::string(RAYSIFT_SOURCE_DIR) + "/datasets/";
   const std::vector<SceneCase> cases = {
       {"engine_opaque", "engine_ct.vdb", "engine_ct_tf.json", "engine_ct_camera.json", false},

@@ -195,9 +195,9 @@ double estimate_reconstruct_ms(int width, int height, int base_spacing) {
 
 SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, const SamplingOptions& options,
                             double elapsed_before_ms) {
+  const Timer clock;
   validate(options);
   const ObjectCounts counts = scan_importance(importance, options.base_spacing);
-  const Timer clock;
   const ElapsedMs now = options.clock_ms ? options.clock_ms : ElapsedMs([&clock] { return clock.elapsed_ms(); });
   const int w = importance.width, h = importance.height;
   SampledFrame frame;
@@ -222,6 +222,7 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
     for (int y : grid.ys)
       for (int x : grid.xs) on_grid(x, y) = importance(x, y) >= 0 ? 1 : 0;
     trace_selection(on_grid, trace, frame, stage);
+    frame.trace_end_ms = clock.elapsed_ms();
     stage.reset();
     if (frame.rays_traced < counts.object) reconstruct_bilinear(frame.image, grid, background_known(importance));
     frame.reconstruct_ms = stage.elapsed_ms();
@@ -241,6 +242,7 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
     trace_selection(selected, trace, frame, stage);
   }
 
+  frame.trace_end_ms = clock.elapsed_ms();
   stage.reset();
   if (frame.rays_traced < counts.object) {
     const ImageMask known = background_known(importance, &frame.traced);
@@ -248,6 +250,14 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
   }
   frame.reconstruct_ms = stage.elapsed_ms();
   return frame;
+}
+
+void BudgetReserve::update(double tail_ms, double frame_ms, double budget_ms) {
+  if (!(std::isfinite(tail_ms) && std::isfinite(frame_ms) && budget_ms > 0)) return;
+  tail_ms_ = tail_ms_ < 0 ? tail_ms : 0.5 * (tail_ms_ + tail_ms);
+  // Half the miss per frame: converges in a few frames without chasing every spike.
+  // Capped: a budget below level 0 overshoots whatever the reserve, and must not wind the margin up for later.
+  margin_ms_ = std::min(0.5 * budget_ms, std::max(0.0, margin_ms_ + 0.5 * (frame_ms - kAim * budget_ms)));
 }
 
 ProgressiveSampler::ProgressiveSampler(const ImageF& importance, const SamplingOptions& options) : options_(options) {
