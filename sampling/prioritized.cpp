@@ -255,9 +255,7 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
 void BudgetReserve::update(double tail_ms, double frame_ms, double budget_ms) {
   if (!(std::isfinite(tail_ms) && std::isfinite(frame_ms) && budget_ms > 0)) return;
   tail_ms_ = tail_ms_ < 0 ? tail_ms : 0.5 * (tail_ms_ + tail_ms);
-  // Half the miss per frame: converges in a few frames without chasing every spike.
-  // Capped: a budget below level 0 overshoots whatever the reserve, and must not wind the margin up for later.
-  margin_ms_ = std::min(0.5 * budget_ms, std::max(0.0, margin_ms_ + 0.5 * (frame_ms - kAim * budget_ms)));
+  margin_.update(frame_ms, budget_ms);
 }
 
 ProgressiveSampler::ProgressiveSampler(const ImageF& importance, const SamplingOptions& options) : options_(options) {

@@ -82,19 +82,17 @@ double estimate_reconstruct_ms(int width, int height, int base_spacing);
 
 /// \brief Budget mode over a sequence of frames: what to pass as SamplingOptions::reconstruct_reserve_ms.
 /// The reserve covers everything a frame does after its last ray (reconstruction, compositing, writing the
-/// masks); it is the running mean of those tails, plus a margin learned from the frames' overshoot (integral
-/// control towards kAim of the budget), so costs the tail does not see (machine load, the last groups of
-/// rays) are paid for too.
+/// masks): 1.1 x the running mean of those tails, plus the OvershootMargin of the frames so far.
 class BudgetReserve {
  public:
-  static constexpr double kAim = 0.97;  ///< frame time / budget aimed at
   /// < 0 until a frame was seen (render_sampled then estimates the reconstruction on a crop).
-  double next_ms() const { return tail_ms_ < 0 ? -1.0 : 1.1 * tail_ms_ + margin_ms_; }
+  double next_ms() const { return tail_ms_ < 0 ? -1.0 : 1.1 * tail_ms_ + margin_.ms(); }
   /// \param tail_ms the frame's time after its last ray; \param frame_ms its whole time; \param budget_ms its budget
   void update(double tail_ms, double frame_ms, double budget_ms);
 
  private:
-  double tail_ms_ = -1, margin_ms_ = 0;
+  double tail_ms_ = -1;
+  OvershootMargin margin_;
 };
 
 /// \brief Progressive refinement for a static camera (RP paper section 5): each frame continues the
