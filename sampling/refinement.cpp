@@ -202,11 +202,17 @@ class Refiner {
 
 
   // Candidates no traced parent will offer: every in-image parent is background.
+  // Their parents lie within S/2, so only open blocks (see mark_open_blocks) can hold them.
   void offer_orphans() {
     push(gather(std::size_t(imp_.height), 16, [this](std::size_t y0, std::size_t y1, std::vector<Candidate>& out) {
       std::vector<Ready> ready;
+      const int s = pattern_.base_spacing;
       for (int y = int(y0); y < int(y1); ++y)
         for (int x = 0; x < imp_.width; ++x) {
+          if (!open_(x / s, y / s)) {
+            x += s - 1 - x % s;  // the rest of this block's row
+            continue;
+          }
           const int level = pattern_.level(x, y);
           if (level == 0 || imp_(x, y) < 0) continue;
           bool orphan = true;
