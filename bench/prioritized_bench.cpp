@@ -10,7 +10,8 @@
 // Scenes: engine CT opaque and translucent (second view), MRI head opaque and translucent, and with --unseen
 // the smoke VDB from the shared datasets (bench/bench_data.h) with a TF written once (normalised to its value range) and never tuned.
 // Usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--linear] [--floor F] [--line-weight W]
-//                          [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N] [--budget-only] [--spacing S]
+//                          [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N] [--budget-only]
+//                          [--guide-only] [--spacing S]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -23,6 +24,7 @@
 #include "bench/bench_data.h"
 #include "core/json_io.h"
 #include "core/timer.h"
+#include "features/raster.h"
 #include "sampling/trade.h"
 #include "volume/transfer_function.h"
 #include "volume/vdb_io.h"
@@ -114,6 +116,7 @@ struct Setup {
   int budget_frames = 10;
   int overhead_only = 0;  ///< > 0: only the overhead table, repeated this many times (for a profiler)
   bool budget_only = false;  ///< only the budget table (engine opaque)
+  bool guide_only = false;   ///< only the guided-reconstruction table
 };
 
 struct Scene {
@@ -247,6 +250,29 @@ struct SceneRun {
     }
   }
 
+  // The edge-aware guide (reconstruction.h) at equal rays: a full-resolution depth raster of the feature mesh.
+  void guide_table() const {
+    const Timer t;
+    const ImageF depth = features::rasterize_depth(geometry.mesh, caster.camera()).depth;
+    const double raster_ms = t.elapsed_ms();
+    std::printf("guided reconstruction (depth raster of the feature mesh, %.1f ms = %.1f%% of the full frame): "
+                "fraction, guided/unguided FLIP 1-SSIM 1-SSIMlin\n", raster_ms, 100 * raster_ms / full_ms);
+    for (double f : {0.03, 0.1, 0.2, 0.4}) {
+      sampling::SamplingOptions s = setup.sampling;
+      s.ray_fraction = f;
+      const Error plain = frame(lines, 0, s).error;
+      s.guide.depth = &depth;
+      std::printf("  %.2f", f);
+      for (float tolerance : {0.02f, 0.1f, 0.3f}) {
+        s.guide.relative_tolerance = tolerance;
+        const Error guided = frame(lines, 0, s).error;
+        std::printf("   tolerance %.2f: %6.3f %6.3f %6.3f", tolerance, guided.flip / plain.flip,
+                    guided.dssim / plain.dssim, guided.dssim_linear / plain.dssim_linear);
+      }
+      std::printf("\n");
+    }
+  }
+
   // Budget mode through the real pipeline (importance included): whole frames against the budget.
   void budget_table() const {
     std::printf("budget mode (%d frames each, today's importance): budget_ms p50_ms p95_ms p95/budget mean_rays "
@@ -283,6 +309,10 @@ void run_scene(const Scene& sc, const Setup& setup, int width, int height, bool 
   for (int k = 1; k < setup.overhead_only; ++k) run.overhead();
   run.overhead();
   if (setup.overhead_only > 0) return;
+  if (setup.guide_only) {
+    run.guide_table();
+    return;
+  }
   if (setup.budget_only) {
     if (budget_table) run.budget_table();
     return;
@@ -321,10 +351,11 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--budget-frames") && more) setup.budget_frames = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--overhead-only") && more) setup.overhead_only = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--budget-only")) setup.budget_only = true;
+    else if (!std::strcmp(argv[i], "--guide-only")) setup.guide_only = true;
     else if (!std::strcmp(argv[i], "--spacing") && more) setup.sampling.base_spacing = std::atoi(argv[++i]);
     else {
       std::fprintf(stderr, "usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--linear] [--floor F] "
-                           "[--line-weight W] [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N] [--budget-only] [--spacing S]\n");
+                           "[--line-weight W] [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N] [--budget-only] [--guide-only] [--spacing S]\n");
       return 2;
     }
   }
