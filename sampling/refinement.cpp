@@ -112,13 +112,12 @@ std::array<std::array<int, 2>, 4> parent_offsets(int level, int spacing) {
 
 // What an offer reads and writes of a pixel whose parents are known, in one 16-byte record: offers touch
 // scattered pixels, and separate images would cost a cache miss each.
-// The cells outlive the frame (see CellBuffer): a cell is valid only when its epoch is the frame's, so a new
-// frame starts by bumping the epoch instead of clearing 20 MB.
+// The cells outlive the frame (frame_buffer, next_epoch): `offered` counts only when the cell's epoch is the
+// frame's, so a new frame bumps the epoch instead of clearing 20 MB. 16-byte aligned: one cache line holds 4.
 struct alignas(16) Cell {
   /// record()ed values of a traced pixel in 1/255 steps (read only for traced pixels: state_ says which).
   std::array<std::uint8_t, 4> percept{};
   std::uint32_t epoch = 0;  ///< frame that last wrote `offered`
-  float unused = 0;
   float offered = 0;       ///< highest priority offered so far in frame `epoch`
 };
 
