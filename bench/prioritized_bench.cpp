@@ -10,11 +10,13 @@
 // Scenes: engine CT opaque and translucent (second view), MRI head opaque and translucent, and with --unseen
 // the smoke VDB from the shared datasets (bench/bench_data.h) with a TF written once (normalised to its value range) and never tuned.
 // Usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--linear] [--floor F] [--line-weight W]
-//                          [--alpha a00,...,a02] [--budget-frames N]
+//                          [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N] [--budget-only]
+//                          [--guide-only] [--spacing S]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -22,6 +24,7 @@
 #include "bench/bench_data.h"
 #include "core/json_io.h"
 #include "core/timer.h"
+#include "features/raster.h"
 #include "sampling/trade.h"
 #include "volume/transfer_function.h"
 #include "volume/vdb_io.h"
@@ -111,6 +114,9 @@ struct Setup {
   sampling::SamplingOptions sampling;  ///< alpha, refinement; mode/fraction/budget set per row
   sampling::FeatureOptions features;
   int budget_frames = 10;
+  int overhead_only = 0;  ///< > 0: only the overhead table, repeated this many times (for a profiler)
+  bool budget_only = false;  ///< only the budget table (engine opaque)
+  bool guide_only = false;   ///< only the guided-reconstruction table
 };
 
 struct Scene {
@@ -163,17 +169,25 @@ struct SceneRun {
   }
 
   // Each mode's own cost without the rays: the same frame with a tracer that returns at once.
+  // Wall time is the minimum of 3; CPU time (all threads, std::clock) is the mean, less disturbed by other
+  // processes on a shared machine.
   void overhead() const {
     const sampling::TraceBatch no_trace = [](Span<const std::uint32_t>, Span<Rgba> out) {
       for (Rgba& c : out) c = Rgba{0.5f, 0.5f, 0.5f, 1.0f};
     };
-    for (double f : {0.1, 0.4}) {
+    auto cpu_ms = [] { return 1000.0 * double(std::clock()) / CLOCKS_PER_SEC; };
+    for (double f : {0.03, 0.1, 0.4}) {
       sampling::SamplingOptions s = setup.sampling;
       s.ray_fraction = f;
+      double c0 = cpu_ms();
       const double p_ms = min_ms(3, [&] { sampling::render_sampled(lines, no_trace, s); });
+      const double p_cpu = (cpu_ms() - c0) / 3;
       s.mode = sampling::SamplingMode::Subsample;
+      c0 = cpu_ms();
       const double s_ms = min_ms(3, [&] { sampling::render_sampled(background, no_trace, s); });
-      std::printf("overhead without rays at fraction %.1f: prioritized %.1f ms, subsample %.1f ms\n", f, p_ms, s_ms);
+      const double s_cpu = (cpu_ms() - c0) / 3;
+      std::printf("overhead without rays at fraction %.2f: prioritized %.1f ms (cpu %.1f), subsample %.1f ms (cpu %.1f)\n",
+                  f, p_ms, p_cpu, s_ms, s_cpu);
     }
   }
 
@@ -236,27 +250,54 @@ struct SceneRun {
     }
   }
 
+  // The edge-aware guide (reconstruction.h) at equal rays: a full-resolution depth raster of the feature mesh.
+  void guide_table() const {
+    const Timer t;
+    const ImageF depth = features::rasterize_depth(geometry.mesh, caster.camera()).depth;
+    const double raster_ms = t.elapsed_ms();
+    std::printf("guided reconstruction (depth raster of the feature mesh, %.1f ms = %.1f%% of the full frame): "
+                "fraction, guided/unguided FLIP 1-SSIM 1-SSIMlin\n", raster_ms, 100 * raster_ms / full_ms);
+    for (double f : {0.03, 0.1, 0.2, 0.4}) {
+      sampling::SamplingOptions s = setup.sampling;
+      s.ray_fraction = f;
+      const Error plain = frame(lines, 0, s).error;
+      s.guide.depth = &depth;
+      std::printf("  %.2f", f);
+      for (float tolerance : {0.02f, 0.1f, 0.3f}) {
+        s.guide.relative_tolerance = tolerance;
+        const Error guided = frame(lines, 0, s).error;
+        std::printf("   tolerance %.2f: %6.3f %6.3f %6.3f", tolerance, guided.flip / plain.flip,
+                    guided.dssim / plain.dssim, guided.dssim_linear / plain.dssim_linear);
+      }
+      std::printf("\n");
+    }
+  }
+
   // Budget mode through the real pipeline (importance included): whole frames against the budget.
+  // The budgets are shares of a full frame timed just before each budget's frames: on a shared machine the
+  // scene's first full frame can be minutes old.
   void budget_table() const {
     std::printf("budget mode (%d frames each, today's importance): budget_ms p50_ms p95_ms p95/budget mean_rays "
-                "level0_only\n", setup.budget_frames);
+                "level0_only [full frame just before]\n", setup.budget_frames);
     for (double share : {0.1, 0.2, 0.4, 0.8}) {
       sampling::SamplingOptions s = setup.sampling;
-      s.budget_ms = share * full_ms;
+      const double full_now = min_ms(2, [&] { volume::render_full(caster); });
+      s.budget_ms = share * full_now;
       std::vector<double> times;
-      double rays = 0, reserve = -1;
+      double rays = 0;
+      sampling::BudgetReserve reserve;  // learned from the previous frames of this budget
       int level0_only = 0;
       for (int k = 0; k < setup.budget_frames; ++k) {
-        s.reconstruct_reserve_ms = reserve;  // the previous frame's measured reconstruction (x1.25), as in RP §5
+        s.reconstruct_reserve_ms = reserve.next_ms();
         const sampling::VolumeFrame f = sampling::render_volume_frame(caster, &geometry, setup.features, s);
         times.push_back(f.total_ms);
         rays += double(f.sampled.rays_traced);
         level0_only += f.sampled.budget_too_small;
-        reserve = 1.25 * f.sampled.reconstruct_ms;
+        reserve.update(f.total_ms - f.importance_ms - f.sampled.trace_end_ms, f.total_ms, s.budget_ms);
       }
       const double p95 = percentile(times, 0.95);
-      std::printf("  %3.0f%% of full %8.0f %6.0f %6.0f %8.3f %9.0f %d\n", share * 100, s.budget_ms,
-                  percentile(times, 0.5), p95, p95 / s.budget_ms, rays / setup.budget_frames, level0_only);
+      std::printf("  %3.0f%% of full %8.0f %6.0f %6.0f %8.3f %9.0f %d [%.0f ms]\n", share * 100, s.budget_ms,
+                  percentile(times, 0.5), p95, p95 / s.budget_ms, rays / setup.budget_frames, level0_only, full_now);
     }
   }
 };
@@ -268,7 +309,17 @@ void run_scene(const Scene& sc, const Setup& setup, int width, int height, bool 
   volume::RenderOptions render;
   render.shading = volume::Shading::Phong;
   SceneRun run(sc, setup, cam, render);
+  for (int k = 1; k < setup.overhead_only; ++k) run.overhead();
   run.overhead();
+  if (setup.overhead_only > 0) return;
+  if (setup.guide_only) {
+    run.guide_table();
+    return;
+  }
+  if (setup.budget_only) {
+    if (budget_table) run.budget_table();
+    return;
+  }
   run.subsample_curve();
   run.equal_time();
   run.equal_rays();
@@ -301,9 +352,13 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--scenes") && more) scenes = argv[++i];
     else if (!std::strcmp(argv[i], "--alpha") && more) setup.sampling.mapping = sampling::parse_priority_mapping(argv[++i]);
     else if (!std::strcmp(argv[i], "--budget-frames") && more) setup.budget_frames = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--overhead-only") && more) setup.overhead_only = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--budget-only")) setup.budget_only = true;
+    else if (!std::strcmp(argv[i], "--guide-only")) setup.guide_only = true;
+    else if (!std::strcmp(argv[i], "--spacing") && more) setup.sampling.base_spacing = std::atoi(argv[++i]);
     else {
       std::fprintf(stderr, "usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--linear] [--floor F] "
-                           "[--line-weight W] [--alpha a00,...,a02] [--budget-frames N]\n");
+                           "[--line-weight W] [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N] [--budget-only] [--guide-only] [--spacing S]\n");
       return 2;
     }
   }
@@ -311,11 +366,11 @@ int main(int argc, char** argv) {
   const int width = quick ? 720 : 1440, height = quick ? 450 : 900;
   const auto& a = setup.sampling.mapping.alpha;
   std::printf("prioritized_bench: %dx%d, phong, contours+silhouettes, %s reconstruction, refinement %s (floor %g, "
-              "line weight %g), alpha %g,%g,%g,%g,%g,%g\n", width, height,
+              "line weight %g), alpha %g,%g,%g,%g,%g,%g, base spacing %d\n", width, height,
               setup.sampling.interpolation == sampling::Interpolation::Cubic ? "cubic" : "linear",
               setup.sampling.refinement.enabled ? "on" : "off",
               setup.sampling.refinement.floor, setup.sampling.refinement.line_weight, a[0], a[1], a[2], a[3], a[4],
-              a[5]);
+              a[5], setup.sampling.base_spacing);
   const std::string dir = std::string(RAYSIFT_SOURCE_DIR) + "/datasets/";
   const std::vector<SceneCase> cases = {
       {"engine_opaque", "engine_ct.vdb", "engine_ct_tf.json", "engine_ct_camera.json", false},

@@ -85,10 +85,11 @@ float FrameRateController::update(const FrameTiming& timing, const RayCountCurve
   const double s = cost_per_ray_ms_ < 0 ? 1.0 : options_.smoothing;
   cost_per_ray_ms_ = s * cost + (1 - s) * std::max(cost_per_ray_ms_, 0.0);
   overhead_ms_ = s * overhead + (1 - s) * std::max(overhead_ms_, 0.0);
+  margin_.update(timing.frame_ms, target_ms());
 
   const float lo = next_frame.alpha00_level0(), hi = next_frame.alpha00_all();
   const double budget_rays = cost_per_ray_ms_ > 0
-                                 ? double(already_traced) + (target_ms() - overhead_ms_) / cost_per_ray_ms_
+                                 ? double(already_traced) + (target_ms() - overhead_ms_ - margin_.ms()) / cost_per_ray_ms_
                                  : double(next_frame.object_pixels());
   if (budget_rays >= double(next_frame.object_pixels())) {
     alpha00_ = hi;

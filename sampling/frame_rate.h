@@ -12,6 +12,7 @@
 #include "core/image.h"
 #include "sampling/fractal_pattern.h"
 #include "sampling/ray_order.h"
+#include "sampling/scheduler.h"
 
 namespace raysift::sampling {
 
@@ -72,18 +73,21 @@ class FrameRateController {
   float alpha00() const { return alpha00_; }
   float threshold() const { return options_.threshold; }
   /// Updates the estimates with the finished frame and chooses α00 for the next one: the largest α00
-  /// whose ray count fits (target - overhead) / cost per ray, clamped to the curve's useful range.
+  /// whose ray count fits (target - overhead - margin) / cost per ray, clamped to the curve's useful range.
   /// \param already_traced rays of the next frame that are already known (a still camera reuses them),
   ///        so only rays beyond these cost time
   /// \return the new α00.
   float update(const FrameTiming& timing, const RayCountCurve& next_frame, std::size_t already_traced = 0);
   double cost_per_ray_ms() const { return cost_per_ray_ms_; }
   double overhead_ms() const { return overhead_ms_; }
+  /// Time kept free on top of the model's overhead, learned from the frames that ran over the target.
+  double margin_ms() const { return margin_.ms(); }
 
  private:
   FrameRateOptions options_;
   float alpha00_;
   double cost_per_ray_ms_ = -1, overhead_ms_ = -1;  ///< < 0 until the first frame
+  OvershootMargin margin_;
 };
 
 }  // namespace raysift::sampling

@@ -12,13 +12,37 @@
 namespace raysift::sampling {
 namespace {
 
-void require_finite_importance(const ImageF& importance) {
+// Per row: object and level-0 object pixels, and the first non-finite value (x, or -1). One parallel pass
+// for the check and the counts, which every frame needs.
+struct RowScan {
+  std::size_t object = 0, level0 = 0;
+  int bad_x = -1;
+};
+
+// \throw InvalidInput naming the first (row-major) NaN/Inf pixel. \return the counts for `spacing`.
+ObjectCounts scan_importance(const ImageF& importance, int spacing) {
   if (importance.width < 1 || importance.height < 1) throw InvalidInput("importance buffer is empty (0x0)");
-  for (std::size_t i = 0; i < importance.size(); ++i)
-    if (!std::isfinite(importance.pixels[i]))
-      throw InvalidInput("importance buffer has a NaN/Inf value at pixel (" +
-                         std::to_string(i % std::size_t(importance.width)) + "," +
-                         std::to_string(i / std::size_t(importance.width)) + ")");
+  std::vector<RowScan> rows(std::size_t(importance.height));
+  const int lattice = spacing - 1;  // validate(): a power of two
+  parallel_rows(importance.height, [&](int y) {
+    const float* row = &importance.pixels[std::size_t(y) * std::size_t(importance.width)];
+    RowScan& r = rows[std::size_t(y)];
+    for (int x = 0; x < importance.width; ++x) {
+      if (!std::isfinite(row[x]) && r.bad_x < 0) r.bad_x = x;
+      r.object += row[x] >= 0 ? 1 : 0;
+    }
+    if ((y & lattice) == 0)
+      for (int x = 0; x < importance.width; x += spacing) r.level0 += row[x] >= 0 ? 1 : 0;
+  });
+  ObjectCounts c;
+  for (std::size_t y = 0; y < rows.size(); ++y) {
+    if (rows[y].bad_x >= 0)
+      throw InvalidInput("importance buffer has a NaN/Inf value at pixel (" + std::to_string(rows[y].bad_x) + "," +
+                         std::to_string(y) + ")");
+    c.object += rows[y].object;
+    c.level0 += rows[y].level0;
+  }
+  return c;
 }
 
 // Background or (with `traced`) traced pixels: what the reconstruction must not change.
@@ -59,22 +83,6 @@ void trace_selection(const ImageMask& selected, const TraceBatch& trace, Sampled
   frame.trace_ms = stage.elapsed_ms();
   mark(rays, frame.traced);
   frame.rays_traced = rays.size();
-}
-
-// The counts without building the pattern (the subsample and full modes do not need it).
-ObjectCounts count_object_pixels(const ImageF& importance, int spacing) {
-  ObjectCounts c;
-  const int mask = spacing - 1;  // validate(): a power of two
-  for (int y = 0; y < importance.height; ++y) {
-    const float* row = &importance.pixels[std::size_t(y) * std::size_t(importance.width)];
-    std::size_t object = 0, level0 = 0;
-    for (int x = 0; x < importance.width; ++x) object += row[x] >= 0 ? 1 : 0;
-    if ((y & mask) == 0)
-      for (int x = 0; x < importance.width; x += spacing) level0 += row[x] >= 0 ? 1 : 0;
-    c.object += object;
-    c.level0 += level0;
-  }
-  return c;
 }
 
 std::size_t ray_target(const SamplingOptions& options, std::size_t object, std::size_t level0) {
@@ -187,17 +195,20 @@ double estimate_reconstruct_ms(int width, int height, int base_spacing) {
 
 SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, const SamplingOptions& options,
                             double elapsed_before_ms) {
-  validate(options);
-  require_finite_importance(importance);
   const Timer clock;
+  validate(options);
+  const ObjectCounts counts = scan_importance(importance, options.base_spacing);
   const ElapsedMs now = options.clock_ms ? options.clock_ms : ElapsedMs([&clock] { return clock.elapsed_ms(); });
   const int w = importance.width, h = importance.height;
+  if (options.guide.depth && (options.guide.depth->width != w || options.guide.depth->height != h))
+    throw InvalidInput("reconstruction guide is " + std::to_string(options.guide.depth->width) + "x" +
+                       std::to_string(options.guide.depth->height) + ", the frame " + std::to_string(w) + "x" +
+                       std::to_string(h));
   SampledFrame frame;
   frame.image = ImageRGBA(w, h);
   frame.traced = ImageMask(w, h, 0);
 
   Timer stage;
-  const ObjectCounts counts = count_object_pixels(importance, options.base_spacing);
   frame.full_rays = counts.object;
   frame.level0_rays = counts.level0;
   const std::size_t target = ray_target(options, counts.object, counts.level0);
@@ -215,6 +226,7 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
     for (int y : grid.ys)
       for (int x : grid.xs) on_grid(x, y) = importance(x, y) >= 0 ? 1 : 0;
     trace_selection(on_grid, trace, frame, stage);
+    frame.trace_end_ms = clock.elapsed_ms();
     stage.reset();
     if (frame.rays_traced < counts.object) reconstruct_bilinear(frame.image, grid, background_known(importance));
     frame.reconstruct_ms = stage.elapsed_ms();
@@ -234,18 +246,25 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
     trace_selection(selected, trace, frame, stage);
   }
 
+  frame.trace_end_ms = clock.elapsed_ms();
   stage.reset();
   if (frame.rays_traced < counts.object) {
     const ImageMask known = background_known(importance, &frame.traced);
-    reconstruct_fractal(frame.image, known, pattern, options.interpolation);
+    reconstruct_fractal(frame.image, known, pattern, options.interpolation, options.guide);
   }
   frame.reconstruct_ms = stage.elapsed_ms();
   return frame;
 }
 
+void BudgetReserve::update(double tail_ms, double frame_ms, double budget_ms) {
+  if (!(std::isfinite(tail_ms) && std::isfinite(frame_ms) && budget_ms > 0)) return;
+  tail_ms_ = tail_ms_ < 0 ? tail_ms : 0.5 * (tail_ms_ + tail_ms);
+  margin_.update(frame_ms, budget_ms);
+}
+
 ProgressiveSampler::ProgressiveSampler(const ImageF& importance, const SamplingOptions& options) : options_(options) {
   validate(options);
-  require_finite_importance(importance);
+  scan_importance(importance, options.base_spacing);
   if (options.mode != SamplingMode::Prioritized)
     throw InvalidInput("progressive frames need the prioritized mode, got " + std::string(sampling_mode_name(options.mode)));
   const Timer timer;

@@ -40,6 +40,9 @@ struct SamplingOptions {
   RefinementOptions refinement;
   /// How the prioritized modes fill untraced pixels (reconstruction.h).
   Interpolation interpolation = Interpolation::Cubic;
+  /// Optional edge-aware guide of the prioritized reconstruction (not owned; off by default, see
+  /// docs/prioritized.md for what it measured).
+  ReconstructionGuide guide;
   int base_spacing = 8;   ///< fractal level-0 spacing, px (power of two)
   int buckets = 256;      ///< priority buckets of the budget/progressive queue
   std::uint64_t seed = 1;
@@ -59,6 +62,8 @@ struct SampledFrame {
   std::size_t full_rays = 0;    ///< object pixels: what the full render traces
   std::size_t level0_rays = 0;  ///< level-0 object pixels (always traced)
   double priorities_ms = 0, trace_ms = 0, reconstruct_ms = 0;
+  /// When the last ray had finished, ms since render_sampled began (what follows is the reserve's share).
+  double trace_end_ms = 0;
   /// Budget mode: the level-0 pattern alone overran the budget (the frame holds only level 0).
   bool budget_too_small = false;
 };
@@ -77,6 +82,21 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
 /// \brief Wall time of one fractal reconstruction of a frame of this size with only level 0 traced
 /// (the worst case), measured once per process on a crop of at most 256x256 and scaled by area.
 double estimate_reconstruct_ms(int width, int height, int base_spacing);
+
+/// \brief Budget mode over a sequence of frames: what to pass as SamplingOptions::reconstruct_reserve_ms.
+/// The reserve covers everything a frame does after its last ray (reconstruction, compositing, writing the
+/// masks): 1.1 x the running mean of those tails, plus the OvershootMargin of the frames so far.
+class BudgetReserve {
+ public:
+  /// < 0 until a frame was seen (render_sampled then estimates the reconstruction on a crop).
+  double next_ms() const { return tail_ms_ < 0 ? -1.0 : 1.1 * tail_ms_ + margin_.ms(); }
+  /// \param tail_ms the frame's time after its last ray; \param frame_ms its whole time; \param budget_ms its budget
+  void update(double tail_ms, double frame_ms, double budget_ms);
+
+ private:
+  double tail_ms_ = -1;
+  OvershootMargin margin_;
+};
 
 /// \brief Progressive refinement for a static camera (RP paper section 5): each frame continues the
 /// priority queue where the previous one stopped (ray_fraction more rays, or until the budget) and

@@ -15,12 +15,12 @@
 namespace raysift::sampling {
 
 /// The six coefficients of the second-order mapping, in the order a00, a10, a01, a11, a20, a02
-/// (first index: power of p_imp, second: power of p_patt). Default: the issue's contract, a20 = a02 = 0 and 0.5
-/// for the other four. With it any line pixel outranks every non-line pixel beyond level 0, which starves flat
-/// interiors at low ray counts; "0.5,0.1,0.5,0.1,0,0" (a10 = a11 = 0.1) gives lines about 1.4-2.8 extra pattern
-/// levels instead and measured better (docs/prioritized.md), so it is the recommended `--alpha`.
+/// (first index: power of p_imp, second: power of p_patt). Default "0.5,0.1,0.5,0.1,0,0", the best measured
+/// (docs/prioritized.md, issue 13 item 4): a10 = a11 = 0.1 gives lines about 1.4-2.8 extra pattern levels. The
+/// paper's 0.5 for all four lets any line pixel outrank every non-line pixel beyond level 0, which starves flat
+/// interiors at low ray counts.
 struct PriorityMapping {
-  std::array<float, 6> alpha{0.5f, 0.5f, 0.5f, 0.5f, 0.0f, 0.0f};
+  std::array<float, 6> alpha{0.5f, 0.1f, 0.5f, 0.1f, 0.0f, 0.0f};
 };
 
 /// \throw InvalidInput unless `text` is six comma-separated finite numbers.

@@ -112,12 +112,13 @@ std::array<std::array<int, 2>, 4> parent_offsets(int level, int spacing) {
 
 // What an offer reads and writes of a pixel whose parents are known, in one 16-byte record: offers touch
 // scattered pixels, and separate images would cost a cache miss each.
+// The cells outlive the frame (frame_buffer, next_epoch): `offered` counts only when the cell's epoch is the
+// frame's, so a new frame bumps the epoch instead of clearing 20 MB. 16-byte aligned: one cache line holds 4.
 struct alignas(16) Cell {
-  /// record()ed values of a traced pixel in 1/255 steps; 0 on background, like its image.
+  /// record()ed values of a traced pixel in 1/255 steps (read only for traced pixels: state_ says which).
   std::array<std::uint8_t, 4> percept{};
-  std::uint32_t unused = 0;
-  float importance = 0;    ///< p_imp
-  float offered = 0;       ///< highest priority offered so far (0 = never)
+  std::uint32_t epoch = 0;  ///< frame that last wrote `offered`
+  float offered = 0;       ///< highest priority offered so far in frame `epoch`
 };
 
 // This thread's w x h image of P, contents unspecified: the refinement's 22 MB of state (at 1440x900) is
@@ -127,6 +128,18 @@ Image<P>& frame_buffer(int w, int h) {
   thread_local Image<P> buffer;
   if (buffer.width != w || buffer.height != h) buffer = Image<P>(w, h);
   return buffer;
+}
+
+// This thread's cells and the epoch of a new frame over them.
+std::uint32_t next_epoch(Image<Cell>& cells) {
+  thread_local const Cell* owner = nullptr;
+  thread_local std::uint32_t epoch = 0;
+  if (owner != cells.pixels.data() || ++epoch == 0) {  // new buffer, or the counter wrapped: clear once
+    std::fill(cells.pixels.begin(), cells.pixels.end(), Cell{});
+    owner = cells.pixels.data();
+    epoch = 1;
+  }
+  return epoch;
 }
 
 // A candidate whose corners are known, with its known parents.
@@ -166,26 +179,39 @@ class Refiner {
   Refiner(const ImageF& importance, const FractalPattern& pattern, const RefinementOptions& options,
           std::uint64_t seed, ImageRGBA& image, ImageMask& traced)
       : imp_(importance), pattern_(pattern), options_(options), image_(image), traced_(traced),
-        cells_(frame_buffer<Cell>(importance.width, importance.height)),
+        cells_(frame_buffer<Cell>(importance.width, importance.height)), epoch_(next_epoch(cells_)),
         state_(frame_buffer<std::uint8_t>(importance.width, importance.height)), queue_(seed) {
-    parallel_rows(imp_.height, [this](int y) {
-      for (int x = 0; x < imp_.width; ++x) {
-        Cell cell;
-        cell.importance = imp_(x, y);
-        cells_(x, y) = cell;
-        state_(x, y) = imp_(x, y) < 0 || traced_(x, y) ? kKnown : 0;
+    // One pass per row of S x S blocks: the state mask and which blocks hold background.
+    const int s = pattern_.base_spacing, bw = (imp_.width + s - 1) / s, bh = (imp_.height + s - 1) / s;
+    Image<std::uint8_t> has_background(bw, bh, 0);
+    parallel_rows(bh, [&](int by) {
+      for (int y = by * s; y < std::min(imp_.height, (by + 1) * s); ++y) {
+        const std::size_t row = std::size_t(y) * std::size_t(imp_.width);
+        for (int x = 0; x < imp_.width; ++x) {
+          const std::size_t i = row + std::size_t(x);
+          const bool background = imp_.pixels[i] < 0;
+          state_.pixels[i] = background ? kKnown | kBackground : traced_.pixels[i] ? kKnown : 0;
+          if (background) has_background(x / s, by) = 1;
+        }
       }
     });
+    mark_open_blocks(has_background);
     for (int l = 0; l < int(level_share_.size()); ++l) level_share_[l] = std::ldexp(1.0f, -l);
   }
 
 
   // Candidates no traced parent will offer: every in-image parent is background.
+  // Their parents lie within S/2, so only open blocks (see mark_open_blocks) can hold them.
   void offer_orphans() {
     push(gather(std::size_t(imp_.height), 16, [this](std::size_t y0, std::size_t y1, std::vector<Candidate>& out) {
       std::vector<Ready> ready;
+      const int s = pattern_.base_spacing;
       for (int y = int(y0); y < int(y1); ++y)
         for (int x = 0; x < imp_.width; ++x) {
+          if (!open_(x / s, y / s)) {
+            x += s - 1 - x % s;  // the rest of this block's row
+            continue;
+          }
           const int level = pattern_.level(x, y);
           if (level == 0 || imp_(x, y) < 0) continue;
           bool orphan = true;
@@ -199,16 +225,18 @@ class Refiner {
     }));
   }
 
-  // `pixels` were traced: marks and record()s them, then offers the children they may have completed.
-  void add_traced(const std::vector<std::uint32_t>& pixels) {
+  // `pixels` were traced: marks and record()s them, then (with `offer`) offers the children they may have
+  // completed. The last round skips the offers: nothing would pop them.
+  void add_traced(const std::vector<std::uint32_t>& pixels, bool offer = true) {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pixels.size(), 1024),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         for (std::size_t i = r.begin(); i < r.end(); ++i) {
                           traced_.pixels[pixels[i]] = 1;
                           state_.pixels[pixels[i]] |= kKnown;
-                          record(pixels[i]);
+                          if (offer) record(pixels[i]);
                         }
                       });
+    if (!offer) return;
     push(gather(pixels.size(), 1024, [&](std::size_t first, std::size_t last, std::vector<Candidate>& out) {
       evaluate_all(last - first, [&](std::size_t i, std::vector<Ready>& ready) { children(pixels[first + i], ready); },
                    out);
@@ -239,10 +267,29 @@ class Refiner {
                               code(std::sqrt(std::max(0.0f, c.b))), code(c.a)};
   }
 
-  // After `pixel` was traced: the children it may have completed, at every finer level.
+  // open_(bx, by) = 1 where the S x S blocks around block (bx, by) hold background (`has`) or reach past the
+  // image: the only places where a corner can be known without being traced.
+  void mark_open_blocks(const Image<std::uint8_t>& has) {
+    const int bw = has.width, bh = has.height;
+    open_ = Image<std::uint8_t>(bw, bh, 0);
+    for (int by = 0; by < bh; ++by)
+      for (int bx = 0; bx < bw; ++bx) {
+        bool open = false;
+        for (int j = by - 1; j <= by + 1; ++j)
+          for (int i = bx - 1; i <= bx + 1; ++i) open = open || i < 0 || j < 0 || i >= bw || j >= bh || has(i, j);
+        open_(bx, by) = open ? 1 : 0;
+      }
+  }
+
+  // After `pixel` was traced: the children it may have completed, at every finer level. A child three or more
+  // levels finer has corners finer than `pixel`, which were traced after it (a pixel is only a candidate once its
+  // corners are known), unless a corner is background or outside the image: only open blocks ask beyond lq + 2.
   void children(std::uint32_t pixel, std::vector<Ready>& ready) const {
     const int w = imp_.width, qx = int(pixel % std::uint32_t(w)), qy = int(pixel / std::uint32_t(w));
-    for (int level = fractal_level(qx, qy, pattern_.base_spacing) + 1; level < pattern_.num_levels; ++level)
+    const int lq = fractal_level(qx, qy, pattern_.base_spacing);
+    const bool open = open_(qx / pattern_.base_spacing, qy / pattern_.base_spacing) != 0;
+    const int end = open ? pattern_.num_levels : std::min(pattern_.num_levels, lq + 3);
+    for (int level = lq + 1; level < end; ++level)
       for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
         const int x = qx - o[0], y = qy - o[1];
         if (x >= 0 && y >= 0 && x < w && y < imp_.height && fractal_level(x, y, pattern_.base_spacing) == level)
@@ -271,6 +318,7 @@ class Refiner {
     }
     for (int i = 0; i < r.known; ++i) __builtin_prefetch(&cells_.pixels[r.parents[i]]);
     __builtin_prefetch(&cells_.pixels[r.pixel]);
+    __builtin_prefetch(&imp_.pixels[r.pixel]);
     ready.push_back(r);
   }
 
@@ -278,8 +326,10 @@ class Refiner {
   void evaluate(const Ready& r, std::vector<Candidate>& out) const {
     // Per channel in integer 1/255 steps; no known parent leaves hi < lo, contrast 0.
     std::array<int, 4> lo{255, 255, 255, 255}, hi{0, 0, 0, 0};
+    constexpr std::array<std::uint8_t, 4> kBackgroundPercept{};  // its image value (0) as record() codes it
     for (int i = 0; i < r.known; ++i) {
-      const std::array<std::uint8_t, 4>& c = cells_.pixels[r.parents[i]].percept;
+      const std::array<std::uint8_t, 4>& c =
+          state_.pixels[r.parents[i]] & kBackground ? kBackgroundPercept : cells_.pixels[r.parents[i]].percept;
       for (int k = 0; k < 4; ++k) {
         lo[k] = std::min(lo[k], int(c[k]));
         hi[k] = std::max(hi[k], int(c[k]));
@@ -288,10 +338,9 @@ class Refiner {
     int spread = 0;
     for (int k = 0; k < 4; ++k) spread = std::max(spread, hi[k] - lo[k]);
     const float contrast = float(spread) * (1.0f / 255.0f);
-    const Cell& cell = cells_.pixels[r.pixel];
     const float priority =
-        (contrast + options_.floor + options_.line_weight * cell.importance) * level_share_[r.level];
-    if (priority <= 1.05f * cell.offered) return;  // see push()
+        (contrast + options_.floor + options_.line_weight * imp_.pixels[r.pixel]) * level_share_[r.level];
+    if (priority <= 1.05f * offered(cells_.pixels[r.pixel])) return;  // see push()
     out.push_back({r.pixel, priority, bucket_of(priority)});
   }
 
@@ -312,12 +361,15 @@ class Refiner {
       const Candidate& c = candidates[i];
       if (i + 16 < candidates.size()) __builtin_prefetch(&cells_.pixels[candidates[i + 16].pixel]);
       // Offered again when another parent was traced: only a clearly higher priority is worth a second entry.
-      float& offered = cells_.pixels[c.pixel].offered;
-      if (c.priority <= 1.05f * offered) continue;
+      Cell& cell = cells_.pixels[c.pixel];
+      if (c.priority <= 1.05f * offered(cell)) continue;
       queue_.push(c.bucket, c.pixel);
-      offered = c.priority;
+      cell.offered = c.priority;
+      cell.epoch = epoch_;
     }
   }
+
+  float offered(const Cell& cell) const { return cell.epoch == epoch_ ? cell.offered : 0.0f; }
 
   const ImageF& imp_;
   const FractalPattern& pattern_;
@@ -325,9 +377,11 @@ class Refiner {
   ImageRGBA& image_;
   ImageMask& traced_;
   Image<Cell>& cells_;
-  static constexpr std::uint8_t kKnown = 1, kTaken = 2;
-  ImageMask& state_;  ///< kKnown: background or traced; kTaken: popped for tracing
+  std::uint32_t epoch_;
+  static constexpr std::uint8_t kKnown = 1, kTaken = 2, kBackground = 4;
+  ImageMask& state_;  ///< kKnown: background or traced (kBackground: background); kTaken: popped for tracing
   BucketQueue queue_;
+  Image<std::uint8_t> open_;  ///< per S x S block, see mark_open_blocks()
   std::array<float, 16> level_share_;  ///< 2^-level, the share of the frame one ray of a level covers
 };
 
@@ -397,18 +451,21 @@ RefinementResult trace_refined(const ImageF& importance, const FractalPattern& p
     std::vector<std::uint32_t> batch = refiner.pop(want);
     const std::size_t popped = batch.size();
     if (popped == 0) break;  // only stale entries were left
+    bool last;
     if (stop.now) {
       in_hashed_tile_order(batch, w, seed);
       const double start = clock();
       batch.resize(trace_until(batch, trace, image, *stop.now, stop.deadline_ms));
       rays_per_ms = std::max(rays_per_ms * 0.25, double(batch.size()) / std::max(1e-3, clock() - start));
+      last = batch.size() < popped || (*stop.now)() >= stop.deadline_ms;
     } else {
       in_tile_order(batch, w);
       trace_all(batch, trace, image);
+      last = result.rays + batch.size() >= stop.rays;
     }
-    refiner.add_traced(batch);
+    refiner.add_traced(batch, !last);
     result.rays += batch.size();
-    if (batch.size() < popped) break;  // the deadline cut the round
+    if (last) break;
   }
   return result;
 }

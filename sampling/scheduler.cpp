@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cmath>
 
 namespace raysift::sampling {
 namespace {
@@ -18,6 +19,11 @@ void trace_group(Span<const std::uint32_t> group, const TraceBatch& trace, Image
 }
 
 }  // namespace
+
+void OvershootMargin::update(double frame_ms, double target_ms) {
+  if (!(std::isfinite(frame_ms) && std::isfinite(target_ms) && target_ms > 0)) return;
+  ms_ = std::min(0.5 * target_ms, std::max(0.0, ms_ + 0.5 * (frame_ms - kAim * target_ms)));
+}
 
 void trace_all(Span<const std::uint32_t> pixels, const TraceBatch& trace, ImageRGBA& image) {
   const std::size_t groups = (pixels.size() + kRayGroup - 1) / kRayGroup;

@@ -25,6 +25,20 @@ void trace_all(Span<const std::uint32_t> pixels, const TraceBatch& trace, ImageR
 /// mock tracer advances by a known cost per ray, so budget behaviour is checked independently of machine load.
 using ElapsedMs = std::function<double()>;
 
+/// \brief A time margin learned from the frames of a sequence that ran over: integral control of frame time /
+/// target towards kAim, so what a cost model does not see (machine load, the last groups of rays) is paid for.
+class OvershootMargin {
+ public:
+  static constexpr double kAim = 0.97;  ///< frame time / target aimed at
+  double ms() const { return ms_; }
+  /// Half the miss per frame (converges in a few frames without chasing every spike), within [0, target / 2]:
+  /// a target nothing can meet must not wind the margin up for later frames. Non-finite input is ignored.
+  void update(double frame_ms, double target_ms);
+
+ private:
+  double ms_ = 0;
+};
+
 /// \brief Traces `queue` from its start in groups of kRayGroup, in order, on all worker threads, and
 /// stops launching new groups once `elapsed_ms()` reaches `deadline_ms`. Groups are claimed in order, so the
 /// traced rays are always a prefix of the queue. \return the length of that prefix.

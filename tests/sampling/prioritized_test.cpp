@@ -219,6 +219,26 @@ TEST(SampledFrame, BudgetBelowLevelZeroStillTracesLevelZero) {
   for (const Rgba& px : frame.image.pixels) ASSERT_TRUE(std::isfinite(px.r) && std::isfinite(px.a));
 }
 
+TEST(BudgetReserve, CoversTheTailAndLearnsTheOvershoot) {
+  BudgetReserve r;
+  EXPECT_LT(r.next_ms(), 0);  // nothing seen: render_sampled estimates it
+  // A frame exactly at the aim: no margin, the reserve is 1.1 x the tail.
+  r.update(10, OvershootMargin::kAim * 100, 100);
+  EXPECT_DOUBLE_EQ(r.next_ms(), 11);
+  // 20 ms over the aim: half of it becomes margin; the tail is averaged (10, 20 -> 15).
+  r.update(20, OvershootMargin::kAim * 100 + 20, 100);
+  EXPECT_DOUBLE_EQ(r.next_ms(), 1.1 * 15 + 10);
+  // Frames under the aim give the margin back, never below 0.
+  r.update(15, OvershootMargin::kAim * 100 - 30, 100);
+  EXPECT_DOUBLE_EQ(r.next_ms(), 1.1 * 15);
+  // A hopeless budget (every frame 10x over) winds the margin up to half the budget at most.
+  for (int k = 0; k < 10; ++k) r.update(15, 1000, 100);
+  EXPECT_DOUBLE_EQ(r.next_ms(), 1.1 * 15 + 50);
+  // Non-finite input is ignored.
+  r.update(NAN, 1000, 100);
+  EXPECT_DOUBLE_EQ(r.next_ms(), 1.1 * 15 + 50);
+}
+
 TEST(SampledFrame, SameImageForOneAndTwoThreads) {
   const ImageF imp = disc_importance();
   for (SamplingMode mode : {SamplingMode::Prioritized, SamplingMode::Subsample}) {
