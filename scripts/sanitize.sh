@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 # -O1: Debug keeps asserts and DCHECKs, -O1 keeps the suite inside CI's budget (-O0 is several times slower).
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g -O1" \
   -DRAYSIFT_SANITIZE=address,undefined -DRAYSIFT_BUILD_BENCH=OFF
-targets=(core_tests volume_tests mesh_tests isosurface_tests features_tests sampling_tests nrr_tests apps_tests)
+targets=(core_tests volume_tests mesh_tests isosurface_tests features_tests sampling_tests nrr_tests apps_tests extremes_tests)
 cmake --build build-asan -j2 --target "${targets[@]}"
 
 # Leaks count as failures (LSan runs inside ASan); halt_on_error makes every finding fatal.
