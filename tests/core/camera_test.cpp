@@ -93,5 +93,21 @@ TEST(Camera, PointsBehindTheEyeDoNotProject) {
   EXPECT_FALSE(cam.project(cam.eye()).has_value());
 }
 
+
+// Fuzz finding (tests/fuzz/corpus/camera/far_eye_1e23.json): an eye 7.9e23 from the target is legal; its rays stay
+// finite unit vectors and the target projects to the image centre, though a unit step from the eye rounds away.
+TEST(Camera, FarEyeStillProjectsItsTarget) {
+  CameraSpec spec;
+  spec.eye = {-118.9, 6.5, 7.88888088888888888888258e23};
+  spec.target = {0, 0, 0};
+  const Camera cam(spec);
+  const Ray r = cam.ray(0.5 * cam.width(), 0.5 * cam.height());
+  EXPECT_NEAR(length(r.direction), 1.0, 1e-12);
+  const auto p = cam.project(spec.target);
+  ASSERT_TRUE(p.has_value());
+  EXPECT_NEAR(p->x_ss, 0.5 * cam.width(), 1e-6);
+  EXPECT_NEAR(p->y_ss, 0.5 * cam.height(), 1e-6);
+}
+
 }  // namespace
 }  // namespace raysift
