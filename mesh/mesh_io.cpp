@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cmath>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "core/errors.h"
@@ -45,6 +46,25 @@ bool is_ply_header_line(const std::string& line) {
   return is_ply_type(b) && (in >> c) && is_ply_type(c) && (in >> rest) && !(in >> word);
 }
 
+/// An ASCII PLY face whose list count is negative or exceeds the numbers on its line makes OpenMesh allocate
+/// gigabytes (found by tests/fuzz). `before_faces` = the lines of the elements that precede "face".
+void reject_bad_ascii_face_counts(std::istream& in, int number, long long before_faces, long long faces,
+                                  const std::string& path) {
+  std::string line;
+  for (long long skipped = 0; skipped < before_faces && std::getline(in, line); ++skipped) ++number;
+  for (long long face = 0; face < faces && std::getline(in, line); ++face) {
+    ++number;
+    std::istringstream tokens(line);
+    long long count = 0;
+    if (!(tokens >> count)) continue;
+    long long rest = 0;
+    for (std::string t; tokens >> t;) ++rest;
+    if (count < 0 || count > rest)
+      throw IoError(path + ":" + std::to_string(number) + ": face list count " + std::to_string(count) +
+                    " does not match the " + std::to_string(rest) + " indices on its line");
+  }
+}
+
 /// Input that Debian's OpenMesh 9 does not survive, rejected before it gets there (found by tests/fuzz): a PLY
 /// header without `end_header` loops its reader forever and a malformed header line crashes it; an OBJ face
 /// corner without a vertex index ("f /1/1 ...") trips an assert that aborts the process.
@@ -52,16 +72,35 @@ void reject_openmesh_traps(const std::string& path, const std::string& ext) {
   if (ext != ".ply" && ext != ".obj") return;
   std::ifstream in(path, std::ios::binary);
   std::string line;
-  bool seen_element = false;
+  bool seen_element = false, ascii = false, seen_face = false;
+  long long before_faces = 0, faces = 0;
+  std::set<std::string> element_names;
   for (int number = 1; std::getline(in, line); ++number) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     const std::string where = path + ":" + std::to_string(number) + ": ";
     if (ext == ".ply") {
-      if (line == "end_header") return;
+      if (line == "end_header") {
+        if (ascii && seen_face) reject_bad_ascii_face_counts(in, number, before_faces, faces, path);
+        return;
+      }
       const bool is_property = line.rfind("property", 0) == 0;  // a property before any element segfaults OpenMesh
       if (number == 1 ? line != "ply" : !is_ply_header_line(line) || (is_property && !seen_element))
         throw IoError(where + "malformed PLY header line '" + line.substr(0, 60) + "'");
       seen_element = seen_element || line.rfind("element", 0) == 0;
+      ascii = ascii || line.rfind("format ascii", 0) == 0;
+      std::istringstream words(line);
+      std::string keyword, name;
+      long long count = 0;
+      if (words >> keyword >> name >> count && keyword == "element" && !element_names.insert(name).second)
+        throw IoError(where + "PLY element '" + name + "' declared twice");  // OpenMesh's header scan loops on it
+      if (!seen_face && keyword == "element") {
+        if (name == "face") {
+          seen_face = true;
+          faces = count;
+        } else {
+          before_faces += std::max(0LL, count);
+        }
+      }
       continue;
     }
     std::istringstream tokens(line);

@@ -101,6 +101,24 @@ TEST(MeshIo, MalformedPlyHeaderLineIsIoErrorNotACrash) {
   EXPECT_NE(io_error_of(path).find(path + ":2: malformed PLY header line"), std::string::npos) << io_error_of(path);
 }
 
+TEST(MeshIo, AsciiPlyFaceCountOutOfRangeIsIoErrorNotAnOutOfMemory) {
+  const std::string path = test::make_temp_dir("mesh_io") + "/count.ply";
+  write_text(path, test::read_text(RAYSIFT_SOURCE_DIR "/tests/fuzz/corpus/ply/negative_face_count.ply"));
+  const std::string msg = io_error_of(path);
+  EXPECT_NE(msg.find(path + ":15: face list count -4 does not match the 4 indices"), std::string::npos) << msg;
+  // Vertices with negative coordinates before the faces are not face lines; a well-formed file still reads.
+  write_text(path, "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                   "element face 1\nproperty list uchar int vertex_indices\nend_header\n-1 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  EXPECT_EQ(read_mesh(path).triangle_count(), 1u);
+}
+
+TEST(MeshIo, PlyElementDeclaredTwiceIsIoErrorNotAHang) {
+  const std::string path = test::make_temp_dir("mesh_io") + "/twice.ply";
+  write_text(path, test::read_text(RAYSIFT_SOURCE_DIR "/tests/fuzz/corpus/ply/timeout_duplicate_elements.ply"));
+  const std::string msg = io_error_of(path);
+  EXPECT_NE(msg.find(path + ":6: PLY element 'vertex' declared twice"), std::string::npos) << msg;
+}
+
 TEST(MeshIo, ObjFaceCornerWithoutVertexIndexIsIoErrorNotAnAbort) {
   const std::string path = test::make_temp_dir("mesh_io") + "/corner.obj";
   write_text(path, test::read_text(RAYSIFT_SOURCE_DIR "/tests/fuzz/corpus/obj/crash_corner_without_vertex.obj"));
