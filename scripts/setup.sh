@@ -18,15 +18,8 @@ case "$mode" in
   test) build_all=ON; packages+=(libgtest-dev libbenchmark-dev libopenvdb-tools openimageio-tools) ;;
   *) echo "usage: scripts/setup.sh demo|test" >&2; exit 2 ;;
 esac
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  sudo=""; [ "$(id -u)" -eq 0 ] || sudo="sudo"
-  $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${missing[@]}"
-fi
+source scripts/install_missing.sh
+install_missing "${packages[@]}"
 
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DRAYSIFT_BUILD_TESTS=$build_all -DRAYSIFT_BUILD_BENCH=$build_all
 if [ "$mode" = test ]; then
