@@ -1,5 +1,7 @@
 #pragma once
-/// \file Triangle-mesh files (PLY, OBJ, OFF) <-> the plain `TriMesh`, through OpenMesh IO. Reading
+/// \file Triangle-mesh files (PLY, OBJ, OFF) <-> the plain `TriMesh`. PLY and OFF are read by raysift's own bounded
+/// readers (mesh/detail/ply_reader.h, off_reader.h: OpenMesh's did not survive fuzzing); OBJ reading and all writing
+/// go through OpenMesh IO. Reading
 /// validates once at the boundary: a loaded mesh has at least one triangle, finite positions and
 /// in-range indices. Polygons are fan-triangulated by default (see MeshReadOptions).
 #include <string>
@@ -21,10 +23,10 @@ struct MeshWriteOptions {
 };
 
 /// Reads a .ply, .obj or .off file (format from the extension, case-insensitive). Vertices that no
-/// face uses are kept. OpenMesh splits non-manifold input connectivity by duplicating the vertices
-/// of faces it cannot attach; the caller sees the result as read.
-/// \throw IoError naming the file if it is missing, unreadable, has another extension, or OpenMesh
-///        cannot parse it.
+/// face uses are kept. PLY and OFF indices are kept as written; for OBJ, OpenMesh splits non-manifold
+/// connectivity by duplicating the vertices of faces it cannot attach, and the caller sees that result.
+/// \throw IoError naming the file (and for PLY/OFF the line) if it is missing, unreadable, has another
+///        extension, or cannot be parsed: a malformed header or number, a count larger than the file, truncation.
 /// \throw InvalidInput naming the file if it has no faces, a non-finite vertex coordinate, or a
 ///        polygon while `triangulate_polygons` is false.
 TriMesh read_mesh(const std::string& path, const MeshReadOptions& options = {});

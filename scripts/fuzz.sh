@@ -11,7 +11,7 @@ packages=(clang-14 libclang-rt-14-dev)
 source scripts/install_missing.sh
 install_missing "${packages[@]}"
 
-targets=(transfer_function scene camera light nrrd raw ply obj)
+targets=(transfer_function scene camera light nrrd raw ply obj off)
 cmake -S . -B build-fuzz -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=Debug \
   -DCMAKE_CXX_FLAGS_DEBUG="-g -O1 -fsanitize-ignorelist=$PWD/scripts/fuzz_ubsan_ignore.txt" \
   -DRAYSIFT_SANITIZE=fuzzer-no-link,address,undefined -DRAYSIFT_BUILD_FUZZ=ON \

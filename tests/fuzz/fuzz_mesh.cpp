@@ -1,4 +1,4 @@
-// Mesh input through OpenMesh IO; built once per format (RAYSIFT_FUZZ_MESH_EXT = ".ply" or ".obj"). A mesh that
+// Mesh input through mesh_io; built once per format (RAYSIFT_FUZZ_MESH_EXT = ".ply", ".obj" or ".off"). A mesh that
 // loads must pass the same validation every mesh stage applies at its entry.
 #include "mesh/mesh_io.h"
 #include "tests/fuzz/fuzz_support.h"
