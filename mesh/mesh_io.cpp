@@ -13,6 +13,7 @@
 #include "mesh/detail/openmesh_convert.h"
 #include "mesh/detail/off_reader.h"
 #include "mesh/detail/ply_reader.h"
+#include "mesh/detail/polygon_fan.h"
 
 namespace raysift::mesh {
 
@@ -62,11 +63,7 @@ TriMesh read_obj(const std::string& path, const MeshReadOptions& options) {
   for (const auto f : poly.faces()) {
     corners.clear();
     for (const auto v : poly.fv_range(f)) corners.push_back(std::uint32_t(v.idx()));
-    if (corners.size() > 3 && !options.triangulate_polygons)
-      throw InvalidInput(file_message(path, "face " + std::to_string(f.idx()) + " has " +
-                                                std::to_string(corners.size()) +
-                                                " corners; expected triangles (enable polygon triangulation)"));
-    for (std::size_t i = 1; i + 1 < corners.size(); ++i) mesh.triangles.push_back({corners[0], corners[i], corners[i + 1]});
+    detail::append_polygon(corners, options.triangulate_polygons, path, f.idx(), mesh);
   }
   return mesh;
 }

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "mesh/detail/polygon_fan.h"
 
 namespace raysift::mesh::detail {
 namespace {
@@ -92,12 +93,9 @@ void add_face(const OffLine& line, std::uint64_t face, bool triangulate_polygons
   const std::uint64_t corners = line.count(0, line.size() - 1, "corner count");
   if (corners < 3) line.fail("face " + std::to_string(face) + " has " + std::to_string(corners) +
                              " corners; a face needs at least 3");
-  if (corners > 3 && !triangulate_polygons)
-    throw InvalidInput(file_message(path, "face " + std::to_string(face) + " has " + std::to_string(corners) +
-                                              " corners; expected triangles (enable polygon triangulation)"));
   std::vector<std::uint32_t> v(corners);
   for (std::uint64_t i = 0; i < corners; ++i) v[i] = std::uint32_t(line.count(1 + i, UINT32_MAX, "vertex index"));
-  for (std::size_t i = 1; i + 1 < v.size(); ++i) mesh.triangles.push_back({v[0], v[i], v[i + 1]});
+  append_polygon(v, triangulate_polygons, path, face, mesh);
 }
 
 }  // namespace

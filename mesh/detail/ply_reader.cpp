@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "mesh/detail/polygon_fan.h"
 
 namespace raysift::mesh::detail {
 namespace {
@@ -269,16 +270,6 @@ void read_vertices(PlyBody& body, const PlyElement& element, const std::string& 
   }
 }
 
-void add_polygon(const PlyBody& body, const std::vector<std::uint32_t>& corners, bool triangulate_polygons,
-                 TriMesh& mesh) {
-  if (corners.size() < 3) body.fail(std::to_string(corners.size()) + " corners; a face needs at least 3");
-  if (corners.size() > 3 && !triangulate_polygons)
-    throw InvalidInput(file_message(body.path(), "face " + std::to_string(body.index()) + " has " +
-                                                     std::to_string(corners.size()) +
-                                                     " corners; expected triangles (enable polygon triangulation)"));
-  for (std::size_t i = 1; i + 1 < corners.size(); ++i) mesh.triangles.push_back({corners[0], corners[i], corners[i + 1]});
-}
-
 void read_faces(PlyBody& body, const PlyElement& element, const std::string& path, bool triangulate_polygons,
                 TriMesh& mesh) {
   std::size_t indices = find_property(element, "vertex_indices", true);
@@ -303,7 +294,9 @@ void read_faces(PlyBody& body, const PlyElement& element, const std::string& pat
         }
         corners.push_back(std::uint32_t(value));
       }
-      if (p == indices) add_polygon(body, corners, triangulate_polygons, mesh);
+      if (p != indices) continue;
+      if (corners.size() < 3) body.fail(std::to_string(corners.size()) + " corners; a face needs at least 3");
+      append_polygon(corners, triangulate_polygons, path, f, mesh);
     }
   }
 }
