@@ -47,6 +47,30 @@ TEST(Pipeline, SphereAreaAndVolumeWithinOnePercentWithoutPreparation) {
   EXPECT_EQ(set.stages.smooth_before.ms, 0.0);  // switched-off stages report 0 ms
 }
 
+TEST(Pipeline, DecimationThatWouldExceedTheMemoryLimitFailsBeforeItStarts) {
+  volume::BallOptions b;
+  b.grid.dims = {64, 64, 64};
+  b.radius_voxels = 24;
+  PipelineOptions o = no_prep();
+  o.iso_values = {0.5};
+  const TriMesh mesh = build_isosurfaces(volume::make_ball(b), nullptr, o).surfaces.at(0).mesh;
+  const std::uint64_t mesh_bytes = mesh.positions.size() * sizeof(Vec3f) + mesh.triangles.size() * 12;
+  // Room for marching cubes and its mesh, not for the decimater's ~140 bytes per triangle.
+  const MemoryLimit limit{3 * mesh_bytes, true};
+  o.marching_cubes.memory_limit = &limit;
+  EXPECT_EQ(build_isosurfaces(volume::make_ball(b), nullptr, o).surfaces.at(0).mesh.triangle_count(),
+            mesh.triangle_count());
+  o.prep.decimation.ratio = 0.5;
+  try {
+    build_isosurfaces(volume::make_ball(b), nullptr, o);
+    FAIL() << "expected ResourceError";
+  } catch (const ResourceError& e) {
+    EXPECT_NE(std::string(e.what()).find("smoothing and decimating " + std::to_string(mesh.triangle_count()) +
+                                         " triangles needs"),
+              std::string::npos) << e.what();
+  }
+}
+
 TEST(Pipeline, PreparedShellsStayClosedSpheresAndReportEveryStage) {
   PipelineOptions o;
   o.iso_values = {0.5};
