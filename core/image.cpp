@@ -1,10 +1,13 @@
 #include "core/image.h"
 
-#include <OpenImageIO/imageio.h>
+#include <dlfcn.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 
+#include "core/detail/image_plugin.h"
 #include "core/file_util.h"
 
 namespace raysift {
@@ -23,47 +26,52 @@ Format format_for(const std::string& path) {
   throw IoError(file_message(path, "unsupported image extension '" + ext + "'; use .png or .exr"));
 }
 
-void write_pixels(const std::string& path, int width, int height, int channels, OIIO::TypeDesc type,
-                  const void* data, const std::vector<std::string>& names = {}) {
+/// The plugin next to the running program (a relocated build), else where this build put it.
+const detail::ImagePluginApi* load_plugin() {
+  std::vector<std::string> candidates;
+  char exe[PATH_MAX];
+  const ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+  if (n > 0) {
+    const std::string dir = std::string(exe, std::size_t(n)).substr(0, std::string(exe, std::size_t(n)).rfind('/') + 1);
+    candidates.push_back(dir + "libraysift_image_plugin.so");
+  }
+  candidates.push_back(RAYSIFT_IMAGE_PLUGIN);
+  std::string reasons;
+  for (const std::string& path : candidates) {
+    void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (!handle) {
+      reasons += std::string(reasons.empty() ? "" : "; ") + dlerror();
+      continue;
+    }
+    using Entry = const detail::ImagePluginApi* (*)();
+    const auto entry = reinterpret_cast<Entry>(dlsym(handle, detail::kImagePluginEntry));
+    const detail::ImagePluginApi* api = entry ? entry() : nullptr;
+    if (api && api->version == detail::kImagePluginVersion) return api;  // kept loaded until exit
+    reasons += "; " + path + " is from another raysift build";
+    dlclose(handle);
+  }
+  throw IoError("image support (OpenImageIO plugin) could not be loaded: " + reasons);
+}
+
+const detail::ImagePluginApi& plugin() {
+  static const detail::ImagePluginApi* api = load_plugin();  // a throw leaves it unset, so the next call retries
+  return *api;
+}
+
+void write_pixels(const std::string& path, int width, int height, int channels, bool as_float, const void* data,
+                  const std::vector<std::string>& names = {}) {
+  const detail::ImagePluginApi& api = plugin();
   write_atomically(path, [&](const std::string& tmp) {
-    auto out = OIIO::ImageOutput::create(tmp);
-    if (!out) throw IoError(file_message(path, "cannot create image writer: " + OIIO::geterror()));
-    OIIO::ImageSpec spec(width, height, channels, type);
-    if (!names.empty()) spec.channelnames = names;
-    if (type == OIIO::TypeDesc::FLOAT) spec.attribute("compression", "zip");
-    // Our colours are final display values: store them as given, never un-premultiplied by alpha.
-    spec.attribute("oiio:UnassociatedAlpha", 1);
-    if (!out->open(tmp, spec)) throw IoError(file_message(path, "cannot open for writing: " + out->geterror()));
-    if (!out->write_image(type, data) || !out->close())
-      throw IoError(file_message(path, "write failed: " + out->geterror()));
+    const std::string error = api.write(tmp, width, height, channels, as_float, data, names);
+    if (!error.empty()) throw IoError(file_message(path, error));
   });
 }
 
-struct RawImage {
-  int width = 0, height = 0, channels = 0;
-  bool is_8bit = false;
-  std::vector<std::string> names;
-  std::vector<float> data;
-};
-
-RawImage read_raw(const std::string& path) {
+detail::PluginImage read_raw(const std::string& path) {
   require_readable_file(path);
-  OIIO::ImageSpec config;
-  config.attribute("oiio:UnassociatedAlpha", 1);  // read colours as stored (see write_pixels)
-  auto in = OIIO::ImageInput::open(path, &config);
-  if (!in) throw IoError(file_message(path, "not a readable image: " + OIIO::geterror()));
-  const OIIO::ImageSpec& spec = in->spec();
-  RawImage img;
-  img.width = spec.width;
-  img.height = spec.height;
-  img.channels = spec.nchannels;
-  img.names = spec.channelnames;
-  img.is_8bit = spec.format == OIIO::TypeDesc::UINT8;
-  if (img.width <= 0 || img.height <= 0 || img.channels <= 0) throw IoError(file_message(path, "image has no pixels"));
-  img.data.resize(std::size_t(img.width) * img.height * img.channels);
-  if (!in->read_image(0, 0, 0, img.channels, OIIO::TypeDesc::FLOAT, img.data.data()))
-    throw IoError(file_message(path, "read failed: " + in->geterror()));
-  in->close();
+  detail::PluginImage img;
+  const std::string error = plugin().read(path, img);
+  if (!error.empty()) throw IoError(file_message(path, error));
   return img;
 }
 
@@ -71,7 +79,7 @@ RawImage read_raw(const std::string& path) {
 
 void write_image(const std::string& path, const ImageRGBA& image) {
   if (format_for(path) == Format::Exr) {
-    write_pixels(path, image.width, image.height, 4, OIIO::TypeDesc::FLOAT, image.pixels.data());
+    write_pixels(path, image.width, image.height, 4, true, image.pixels.data());
     return;
   }
   std::vector<std::uint8_t> bytes(image.size() * 4);
@@ -82,28 +90,28 @@ void write_image(const std::string& path, const ImageRGBA& image) {
     bytes[4 * i + 2] = to_byte(linear_to_srgb(p.b));
     bytes[4 * i + 3] = to_byte(p.a);
   }
-  write_pixels(path, image.width, image.height, 4, OIIO::TypeDesc::UINT8, bytes.data());
+  write_pixels(path, image.width, image.height, 4, false, bytes.data());
 }
 
 void write_image(const std::string& path, const ImageF& image) {
   if (format_for(path) == Format::Exr) {
-    write_pixels(path, image.width, image.height, 1, OIIO::TypeDesc::FLOAT, image.pixels.data(), {"Y"});
+    write_pixels(path, image.width, image.height, 1, true, image.pixels.data(), {"Y"});
     return;
   }
   std::vector<std::uint8_t> bytes(image.size());
   for (std::size_t i = 0; i < image.size(); ++i) bytes[i] = to_byte(linear_to_srgb(image.pixels[i]));
-  write_pixels(path, image.width, image.height, 1, OIIO::TypeDesc::UINT8, bytes.data());
+  write_pixels(path, image.width, image.height, 1, false, bytes.data());
 }
 
 void write_channels_exr(const std::string& path, const ChannelImage& image) {
   if (format_for(path) != Format::Exr) throw IoError(file_message(path, "multi-channel images must be .exr"));
   RAYSIFT_CHECK_OP(image.data.size(), ==, std::size_t(image.width) * image.height * image.channel_names.size());
-  write_pixels(path, image.width, image.height, int(image.channel_names.size()), OIIO::TypeDesc::FLOAT,
+  write_pixels(path, image.width, image.height, int(image.channel_names.size()), true,
                image.data.data(), image.channel_names);
 }
 
 ImageRGBA read_image_rgba(const std::string& path) {
-  RawImage raw = read_raw(path);
+  detail::PluginImage raw = read_raw(path);
   ImageRGBA out(raw.width, raw.height);
   const auto decode = [&](float v) { return raw.is_8bit ? srgb_to_linear(v) : v; };
   for (std::size_t i = 0; i < out.size(); ++i) {
@@ -120,7 +128,7 @@ ImageRGBA read_image_rgba(const std::string& path) {
 }
 
 ImageF read_image_float(const std::string& path) {
-  RawImage raw = read_raw(path);
+  detail::PluginImage raw = read_raw(path);
   ImageF out(raw.width, raw.height);
   for (std::size_t i = 0; i < out.size(); ++i) {
     const float v = raw.data[i * raw.channels];
@@ -130,7 +138,7 @@ ImageF read_image_float(const std::string& path) {
 }
 
 ChannelImage read_channels(const std::string& path) {
-  RawImage raw = read_raw(path);
+  detail::PluginImage raw = read_raw(path);
   return {raw.width, raw.height, raw.names, std::move(raw.data)};
 }
 
