@@ -10,6 +10,10 @@
 #include "core/detail/image_plugin.h"
 #include "core/file_util.h"
 
+#ifdef RAYSIFT_IMAGE_PLUGIN_LINKED
+extern "C" const raysift::detail::ImagePluginApi* raysift_image_plugin_api();  // sanitizer builds (CMakeLists.txt)
+#endif
+
 namespace raysift {
 namespace {
 
@@ -26,14 +30,17 @@ Format format_for(const std::string& path) {
   throw IoError(file_message(path, "unsupported image extension '" + ext + "'; use .png or .exr"));
 }
 
+#ifdef RAYSIFT_IMAGE_PLUGIN_LINKED
+const detail::ImagePluginApi* load_plugin() { return raysift_image_plugin_api(); }
+#else
 /// The plugin next to the running program (a relocated build), else where this build put it.
 const detail::ImagePluginApi* load_plugin() {
   std::vector<std::string> candidates;
   char exe[PATH_MAX];
   const ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
   if (n > 0) {
-    const std::string dir = std::string(exe, std::size_t(n)).substr(0, std::string(exe, std::size_t(n)).rfind('/') + 1);
-    candidates.push_back(dir + "libraysift_image_plugin.so");
+    const std::string program(exe, std::size_t(n));
+    candidates.push_back(program.substr(0, program.rfind('/') + 1) + "libraysift_image_plugin.so");
   }
   candidates.push_back(RAYSIFT_IMAGE_PLUGIN);
   std::string reasons;
@@ -52,6 +59,7 @@ const detail::ImagePluginApi* load_plugin() {
   }
   throw IoError("image support (OpenImageIO plugin) could not be loaded: " + reasons);
 }
+#endif
 
 const detail::ImagePluginApi& plugin() {
   static const detail::ImagePluginApi* api = load_plugin();  // a throw leaves it unset, so the next call retries
