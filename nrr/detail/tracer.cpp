@@ -102,24 +102,20 @@ bool visibility_redundant(const SampledScene& scene, const Camera& camera, Redun
 
 namespace {
 
-/// Visibility NRR (Alg. 1 with Alg. 2 or its frustum variant), peeling front faces in rounds: each
-/// round traces the nearest front face beyond the last redundant one for every unresolved ray (the
-/// fast culled path, 16-wide packets) and tests all of them at once with occlusion rays toward the
-/// earlier eyes (rtcOccluded16 packets). A face that cannot be redundant (facing away from every
-/// earlier eye, or outside every earlier frustum) is kept without a ray.
-void trace_visibility(const SampledScene& scene, const ImageRule& rule, Span<const mesh::RayF> rays,
-                      Span<mesh::Hit> hits, const mesh::QueryOptions& culled) {
-  const Redundancy redundancy = redundancy_of(rule.mode);
-  std::vector<mesh::RayF> current(rays.begin(), rays.end());
+/// Marks redundant[k] = 1 for the faces found[k] (hit along rays[active[k]]) that are redundant.
+using RedundancyMarker = std::function<void(Span<const mesh::Hit> found, Span<const std::size_t> active,
+                                            std::vector<std::uint8_t>& redundant)>;
+
+/// Alg. 1 peeling front faces in rounds: each round traces, for every unresolved ray, the nearest front
+/// face beyond the last redundant one (the fast culled path, 16-wide packets) and asks `mark` about all
+/// of them at once; a ray is resolved by its first non-redundant face or a miss.
+void trace_in_rounds(const SampledScene& scene, Span<const mesh::RayF> rays, Span<mesh::Hit> hits,
+                     const mesh::QueryOptions& culled, const RedundancyMarker& mark) {
+  std::vector<mesh::RayF> current(rays.begin(), rays.end()), batch;
   std::vector<std::size_t> active(rays.size());
   for (std::size_t i = 0; i < rays.size(); ++i) active[i] = i;
-  mesh::QueryOptions occluders;
-  occluders.cull_back_faces = true;  // back faces do not occlude: the culled images cannot show them
-  occluders.is_coherent = culled.is_coherent;  // one eye to the points of one tile
-  std::vector<mesh::RayF> batch, shadow;
   std::vector<mesh::Hit> found;
-  std::vector<std::size_t> owner;
-  std::vector<std::uint8_t> blocked, redundant;
+  std::vector<std::uint8_t> redundant;
   // Beyond a redundant face the nearest face is often a back face (the far side of a slab or box),
   // which makes the two-pass culled query trace twice: later rounds cull inside one traversal, which
   // a filter that accepts everything selects.
@@ -131,9 +127,39 @@ void trace_visibility(const SampledScene& scene, const ImageRule& rule, Span<con
     for (std::size_t a : active) batch.push_back(current[a]);
     found.assign(batch.size(), mesh::Hit{});
     scene.rays().intersect(Span<const mesh::RayF>(batch), Span<mesh::Hit>(found), is_first ? culled : culled_once);
-    // One camera at a time, so a packet's rays share their origin, and only for faces no earlier
-    // camera has shown redundant yet.
     redundant.assign(active.size(), 0);
+    mark(Span<const mesh::Hit>(found), Span<const std::size_t>(active), redundant);
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < active.size(); ++k) {
+      const std::size_t a = active[k];
+      if (!found[k].is_hit() || !redundant[k]) {
+        hits[a] = found[k];
+        continue;
+      }
+      // Beyond this face; a second report of the same point (a shared edge) is the same sample.
+      const float t = found[k].t;
+      current[a].t_near = std::max(std::nextafter(t, kInfinityF), t * (1.0f + kSameHitRelative));
+      active[kept++] = a;
+    }
+    active.resize(kept);
+  }
+}
+
+/// Visibility (Alg. 2 or its frustum variant) of a round's faces: coherent occlusion packets
+/// (rtcOccluded16), one earlier camera at a time so a packet's rays share their origin, and only for
+/// faces no earlier camera has shown redundant; a face facing away from the eye (or, for the frustum
+/// variant, outside the frustum) needs no ray.
+RedundancyMarker visibility_marker(const SampledScene& scene, const ImageRule& rule, Span<const mesh::RayF> rays,
+                                   bool is_coherent) {
+  return [&scene, &rule, rays, is_coherent](Span<const mesh::Hit> found, Span<const std::size_t> active,
+                                            std::vector<std::uint8_t>& redundant) {
+    const Redundancy redundancy = redundancy_of(rule.mode);
+    mesh::QueryOptions occluders;
+    occluders.cull_back_faces = true;  // back faces do not occlude: the culled images cannot show them
+    occluders.is_coherent = is_coherent;
+    std::vector<mesh::RayF> shadow;
+    std::vector<std::size_t> owner;
+    std::vector<std::uint8_t> blocked;
     for (const Camera& cam : rule.previous_cameras) {
       const Vec3f eye(cam.eye());
       shadow.clear();
@@ -150,20 +176,7 @@ void trace_visibility(const SampledScene& scene, const ImageRule& rule, Span<con
       for (std::size_t r = 0; r < shadow.size(); ++r)
         if (!blocked[r]) redundant[owner[r]] = 1;
     }
-    std::size_t kept = 0;
-    for (std::size_t k = 0; k < active.size(); ++k) {
-      const std::size_t a = active[k];
-      if (!redundant[k]) {
-        hits[a] = found[k];
-        continue;
-      }
-      // Beyond this face; a second report of the same point (a shared edge) is the same sample.
-      const float t = found[k].t;
-      current[a].t_near = std::max(std::nextafter(t, kInfinityF), t * (1.0f + kSameHitRelative));
-      active[kept++] = a;
-    }
-    active.resize(kept);
-  }
+  };
 }
 
 }  // namespace
@@ -190,7 +203,8 @@ void trace(const SampledScene& scene, const ImageRule& rule, Span<const mesh::Ra
         return true;
       };
       // The filter is pure, but QueryOptions::is_filter_pure stays off: redundancy rejects 15-50 % of
-      // the nearest hits of later images, and re-tracing those measured slower than one filtered pass.
+      // the nearest hits of later images, and re-tracing those (from scratch, or in rounds beyond the
+      // rejected face as visibility does) measured slower than one filtered pass: 1.7x vs 1.4x on grass.
       options.filter = &keep_non_redundant;
       scene.rays().intersect(rays, hits, options);
       return;
@@ -201,7 +215,7 @@ void trace(const SampledScene& scene, const ImageRule& rule, Span<const mesh::Ra
         scene.rays().intersect(rays, hits, options);
         return;
       }
-      trace_visibility(scene, rule, rays, hits, options);
+      trace_in_rounds(scene, rays, hits, options, visibility_marker(scene, rule, rays, is_coherent));
       return;
     }
     case SamplingMode::Peel: {
