@@ -61,13 +61,14 @@ struct MetricsContext {
   SamplingMode mode;
   Span<const DepthImage> reference, conventional;
   bool threaded, by_pixel;
+  Redundancy redundancy;
   std::vector<Camera> ref_cameras, conv_cameras;
   std::vector<detail::PixelProjector> ref_projectors, conv_projectors;
 
   MetricsContext(const SampledScene& s, SamplingMode m, Span<const DepthImage> ref, Span<const DepthImage> conv,
                  const MetricsOptions& options)
       : scene(s), mode(m), reference(ref), conventional(conv), threaded(options.threaded),
-        by_pixel(options.redundancy == Redundancy::Pixel) {
+        by_pixel(options.redundancy == Redundancy::Pixel), redundancy(options.redundancy) {
     for (const DepthImage& im : reference) ref_cameras.emplace_back(im.camera);
     for (const DepthImage& im : conventional) conv_cameras.emplace_back(im.camera);
     for (const Camera& camera : ref_cameras) ref_projectors.emplace_back(camera);
@@ -77,7 +78,8 @@ struct MetricsContext {
   /// Whether `image` (taken by `camera`) captured the surface point x of triangle id, by the redundancy rule.
   bool captured(const DepthImage& image, const Camera& camera, const detail::PixelProjector& projector, const Vec3f& x,
                 mesh::TriangleId id) const {
-    return by_pixel ? detail::pixel_captured(image, projector, x, id) : detail::visible_from(scene, camera, x, id);
+    return by_pixel ? detail::pixel_captured(image, projector, x, id)
+                    : detail::visibility_redundant(scene, camera, redundancy, x, id);
   }
 };
 
@@ -92,7 +94,7 @@ void classify_image(const MetricsContext& c, std::size_t i, ImageMetrics& image_
   image_metrics.redundant = count_if_index(im.pixel_count(), c.threaded, [&](std::size_t p) {
     if (!im.has_sample(p)) return false;
     for (std::size_t j = 0; j < i; ++j)
-      if (c.captured(c.reference[j], c.ref_cameras[j], c.ref_projectors[j], im.position_ws[p], im.triangle_id[p]))
+      if (c.captured(c.reference[j], c.ref_cameras[j], c.ref_projectors[j], im.position_ws(p), im.triangle_id[p]))
         return true;
     return false;
   });
@@ -107,7 +109,7 @@ void classify_image(const MetricsContext& c, std::size_t i, ImageMetrics& image_
       // directly (also right for hits at t = 0, which cannot be projected).
       const bool is_same_view = c.by_pixel && j == i && c.mode != SamplingMode::Peel;
       if (is_same_view ? c.conventional[j].triangle_id[p] == im.triangle_id[p]
-                       : c.captured(c.conventional[j], c.conv_cameras[j], c.conv_projectors[j], im.position_ws[p],
+                       : c.captured(c.conventional[j], c.conv_cameras[j], c.conv_projectors[j], im.position_ws(p),
                                     im.triangle_id[p]))
         return false;
     }
@@ -118,13 +120,16 @@ void classify_image(const MetricsContext& c, std::size_t i, ImageMetrics& image_
 
 /// Metric (4): whether the reference images hold the surface point x of triangle id.
 bool is_available(const MetricsContext& c, const Vec3f& x, mesh::TriangleId id) {
-  // Conventional and visibility-NRR images hold every point visible from one of their eyes (a point
-  // visible from V_j is in I_j or, being redundant, in an earlier image): a cheap occlusion ray settles
-  // most samples before the full rule is traced. For conventional images the rule adds nothing more.
-  const bool holds_all_visible = c.mode == SamplingMode::Conventional || c.mode == SamplingMode::NrrVisibility;
+  // Whether an image holds x is a fact about the image, so it always includes the image's frustum,
+  // whichever visibility definition the metrics use. Conventional and frustum-visibility NRR images
+  // hold every point visible inside one of their frusta (a point visible in I_j is in I_j or, being
+  // redundant, in an earlier image): a cheap occlusion ray settles most samples before the full rule
+  // is traced. Alg. 2 NRR images do not: a point seen from V_j outside I_j's frustum is in none.
+  const bool holds_all_visible =
+      c.mode == SamplingMode::Conventional || c.mode == SamplingMode::NrrVisibilityFrustum;
   if (!c.by_pixel && holds_all_visible) {
     for (const Camera& cam : c.ref_cameras)
-      if (detail::visible_from(c.scene, cam, x, id)) return true;
+      if (detail::visible_in_image(c.scene, cam, x, id)) return true;
     if (c.mode == SamplingMode::Conventional) return false;
   }
   for (std::size_t i = 0; i < c.reference.size(); ++i) {
@@ -133,7 +138,7 @@ bool is_available(const MetricsContext& c, const Vec3f& x, mesh::TriangleId id) 
       continue;
     }
     const Camera& cam = c.ref_cameras[i];
-    if (!detail::may_be_visible_from(c.scene, cam, x, id)) continue;
+    if (!detail::faces_eye(c.scene, cam.eye(), x, id) || !detail::in_frustum(cam, x)) continue;
     const Vec3f eye(cam.eye());
     const mesh::RayF ray{eye, x - eye};
     mesh::Hit hit;
@@ -162,7 +167,7 @@ void evaluate_intermediate_views(const MetricsContext& c, Span<const CameraSpec>
     const std::size_t samples = frame.sample_count();
     if (samples > 0) {
       const std::size_t available = count_if_index(frame.pixel_count(), c.threaded, [&](std::size_t p) {
-        return frame.has_sample(p) && is_available(c, frame.position_ws[p], frame.triangle_id[p]);
+        return frame.has_sample(p) && is_available(c, frame.position_ws(p), frame.triangle_id[p]);
       });
       const double pct = 100.0 * double(available) / double(samples);
       pct_sum += pct;
@@ -173,7 +178,7 @@ void evaluate_intermediate_views(const MetricsContext& c, Span<const CameraSpec>
     count_if_index(disoccluded.size(), c.threaded, [&](std::size_t k) {
       const auto [i, p] = disoccluded[k];
       if (m.sample_classes[i][p] == SampleClass::Useful) return false;
-      if (!c.captured(frame, frame_camera, frame_projector, c.reference[i].position_ws[p],
+      if (!c.captured(frame, frame_camera, frame_projector, c.reference[i].position_ws(p),
                       c.reference[i].triangle_id[p]))
         return false;
       m.sample_classes[i][p] = SampleClass::Useful;
@@ -184,14 +189,6 @@ void evaluate_intermediate_views(const MetricsContext& c, Span<const CameraSpec>
 }
 
 }  // namespace
-
-Redundancy parse_redundancy(const std::string& name) {
-  if (name == "pixel") return Redundancy::Pixel;
-  if (name == "visibility") return Redundancy::Visibility;
-  throw InvalidInput("redundancy must be one of: pixel, visibility; got '" + name + "'");
-}
-
-std::string to_string(Redundancy redundancy) { return redundancy == Redundancy::Pixel ? "pixel" : "visibility"; }
 
 SamplingMetrics compute_sampling_metrics(const SampledScene& scene, SamplingMode mode, Span<const CameraSpec> views,
                                          Span<const DepthImage> reference, Span<const DepthImage> conventional,
@@ -211,6 +208,7 @@ SamplingMetrics compute_sampling_metrics(const SampledScene& scene, SamplingMode
 
 ImageRGBA sample_class_image(const DepthImage& image, const std::vector<SampleClass>& classes) {
   RAYSIFT_CHECK_OP(classes.size(), ==, image.pixel_count());
+  RAYSIFT_CHECK_OP(image.normal_ws.size(), ==, image.pixel_count());
   ImageRGBA out(image.width, image.height, Rgba{0, 0, 0, 1});
   const Vec3d view = normalize(image.camera.target - image.camera.eye);
   for (std::size_t p = 0; p < classes.size(); ++p) {

@@ -12,12 +12,6 @@
 
 namespace raysift::nrr {
 
-enum class Redundancy { Pixel, Visibility };
-
-/// "pixel" or "visibility". \throw InvalidInput otherwise.
-Redundancy parse_redundancy(const std::string& name);
-std::string to_string(Redundancy redundancy);
-
 /// Per-sample class, for the Fig. 6 style images.
 enum class SampleClass : std::uint8_t { Empty, Ordinary, Disoccluded, Useful };
 
@@ -30,9 +24,10 @@ struct ImageMetrics {
 
 struct SamplingMetrics {
   std::vector<ImageMetrics> images;
-  double available_avg_pct = 100.0;  ///< (4) mean over frames of % of a frame's samples available
-  double available_min_pct = 100.0;  ///< (4) minimum over frames
-  std::size_t frames_with_samples = 0;  ///< frames entering (4); empty frames are skipped
+  double available_avg_pct = 0.0;  ///< (4) mean over frames of % of a frame's samples available
+  double available_min_pct = 0.0;  ///< (4) minimum over frames
+  /// Frames entering (4); empty frames are skipped, and with none (4) is 0, not a 0/0.
+  std::size_t frames_with_samples = 0;
   std::vector<std::vector<SampleClass>> sample_classes;  ///< per reference image, per pixel
 };
 
@@ -55,7 +50,7 @@ SamplingMetrics compute_sampling_metrics(const SampledScene& scene, SamplingMode
                                          Span<const CameraSpec> intermediate, const MetricsOptions& options = {});
 
 /// Fig. 6 colouring: useful samples yellow, other disoccluded samples green, ordinary samples grey
-/// shaded by their normal's facing, empty pixels black.
+/// shaded by their normal's facing, empty pixels black. \pre image.normal_ws is filled (fill_normals).
 ImageRGBA sample_class_image(const DepthImage& image, const std::vector<SampleClass>& classes);
 
 }  // namespace raysift::nrr

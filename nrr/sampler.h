@@ -16,11 +16,29 @@
 
 namespace raysift::nrr {
 
-enum class SamplingMode { Conventional, NrrPixel, NrrVisibility, Peel };
+/// The redundancy definitions of Xie, Wang & Popescu 2016, by name. A sample x of triangle t is
+/// redundant with an earlier image I_j when:
+/// - Pixel (Alg. 3): x reprojects into I_j onto a pixel holding t;
+/// - Visibility (Alg. 2): the first surface hit from V_j toward x is x, nothing else (hits are
+///   front faces only, as every image culls back faces, so x's face must look at V_j);
+/// - VisibilityFrustum: Visibility and x lies inside I_j's frustum ([choice] ALGORITHMS.md §10).
+enum class Redundancy { Pixel, Visibility, VisibilityFrustum };
 
-/// "conventional", "nrr-pixel", "nrr-visibility", "peel". \throw InvalidInput for anything else.
+/// "pixel", "visibility", "visibility-frustum". \throw InvalidInput otherwise.
+Redundancy parse_redundancy(const std::string& name);
+std::string to_string(Redundancy redundancy);
+
+/// NrrVisibility is Alg. 2 exactly; NrrVisibilityFrustum adds the frustum test (see Redundancy).
+enum class SamplingMode { Conventional, NrrPixel, NrrVisibility, NrrVisibilityFrustum, Peel };
+
+/// "conventional", "nrr-pixel", "nrr-visibility", "nrr-visibility-frustum", "peel".
+/// \throw InvalidInput for anything else.
 SamplingMode parse_sampling_mode(const std::string& name);
 std::string to_string(SamplingMode mode);
+/// The NRR mode that renders with `redundancy`.
+SamplingMode nrr_mode(Redundancy redundancy);
+/// The redundancy an NRR mode renders with. \pre mode is one of the Nrr* modes.
+Redundancy redundancy_of(SamplingMode mode);
 
 /// A mesh prepared for sampling: its Embree scene, triangle normals and per-corner shading normals
 /// (area-weighted over the faces around the vertex within a 45 degree crease angle).
@@ -36,6 +54,9 @@ class SampledScene {
   /// Corner normals interpolated at barycentrics (u, v); `face_normal` (the unit normal of triangle
   /// `id`, e.g. mesh::Hit::normal_ws) for flat triangles or where the interpolation faces away.
   Vec3f shading_normal(mesh::TriangleId id, float u, float v, const Vec3f& face_normal) const;
+  /// shading_normal at the sample point x on triangle `id` hit by a ray from `origin` (barycentrics
+  /// recomputed from x; the face normal as Embree reports it for that ray).
+  Vec3f shading_normal_at(mesh::TriangleId id, const Vec3f& x, const Vec3f& origin) const;
   /// Scene bounding-box diagonal, world units.
   double diagonal() const { return rays_.bounds().diagonal(); }
   /// Mean triangle edge length, world units (for the triangle-size / pixel-size ratio in reports).
@@ -43,11 +64,18 @@ class SampledScene {
 
  private:
   mesh::RayScene rays_;
+  TriMesh mesh_;  ///< for the barycentrics of derived shading normals
   std::vector<Vec3d> face_normals_;
   std::vector<std::array<Vec3f, 3>> corner_normals_;  ///< per triangle, normals at its corners
   std::vector<std::uint8_t> is_flat_;                 ///< per triangle: corner normals == face normal
   double mean_edge_ = 0.0;
 };
+
+enum class NormalKind { Face, Shading };
+
+/// Fills image.normal_ws (the lean record derives normals on demand): per sample the unit normal of
+/// its triangle's front face, or the interpolated shading normal; zero where empty.
+void fill_normals(const SampledScene& scene, DepthImage& image, NormalKind kind);
 
 struct SamplingOptions {
   SamplingMode mode = SamplingMode::NrrPixel;

@@ -1,12 +1,11 @@
 #include "nrr/detail/tracer.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/errors.h"
+#include "core/parallel.h"
 #include "core/tolerances.h"
 
 namespace raysift::nrr::detail {
@@ -16,6 +15,7 @@ namespace {
 /// same surface point hit on a shared edge; one of them is dropped (ALGORITHMS.md §10).
 constexpr float kSameHitRelative = 1e-6f;
 constexpr int kTile = 16;
+constexpr float kInfinityF = std::numeric_limits<float>::infinity();
 constexpr int kBlock = 4;
 
 struct Candidate {
@@ -71,21 +71,115 @@ bool pixel_captured(const DepthImage& image, const PixelProjector& projector, co
   return pixel >= 0 && image.triangle_id[std::size_t(pixel)] == id;
 }
 
-bool may_be_visible_from(const SampledScene& scene, const Camera& camera, const Vec3f& x, mesh::TriangleId id) {
-  const Vec3d to_x = Vec3d(x) - camera.eye();
-  if (!(dot(scene.face_normal(id), to_x) < 0.0)) return false;
+bool in_frustum(const Camera& camera, const Vec3f& x) {
   const auto p = camera.project(Vec3d(x));
   return p && p->x_ss >= 0.0 && p->x_ss < camera.width() && p->y_ss >= 0.0 && p->y_ss < camera.height();
 }
 
-bool visible_from(const SampledScene& scene, const Camera& camera, const Vec3f& x, mesh::TriangleId id) {
-  if (!may_be_visible_from(scene, camera, x, id)) return false;
-  const Vec3f eye(camera.eye());
-  // Back faces do not occlude: the image from `camera` culls them, so they cannot hide x in it.
+bool faces_eye(const SampledScene& scene, const Vec3d& eye, const Vec3f& x, mesh::TriangleId id) {
+  return dot(scene.face_normal(id), Vec3d(x) - eye) < 0.0;
+}
+
+bool line_of_sight(const SampledScene& scene, const Vec3d& eye_d, const Vec3f& x, mesh::TriangleId id) {
+  if (!faces_eye(scene, eye_d, x, id)) return false;
+  const Vec3f eye(eye_d);
   mesh::QueryOptions cull;
   cull.cull_back_faces = true;
   return !scene.rays().occluded({eye, x - eye, 0.0f, 1.0f - float(tol::kSegmentEndRelative)}, cull);
 }
+
+bool may_be_visibility_redundant(const SampledScene& scene, const Camera& camera, Redundancy redundancy,
+                                 const Vec3f& x, mesh::TriangleId id) {
+  RAYSIFT_CHECK(redundancy != Redundancy::Pixel);
+  return faces_eye(scene, camera.eye(), x, id) &&
+         (redundancy == Redundancy::Visibility || in_frustum(camera, x));
+}
+
+bool visibility_redundant(const SampledScene& scene, const Camera& camera, Redundancy redundancy, const Vec3f& x,
+                          mesh::TriangleId id) {
+  return may_be_visibility_redundant(scene, camera, redundancy, x, id) && line_of_sight(scene, camera.eye(), x, id);
+}
+
+namespace {
+
+/// Marks redundant[k] = 1 for the faces found[k] (hit along rays[active[k]]) that are redundant.
+using RedundancyMarker = std::function<void(Span<const mesh::Hit> found, Span<const std::size_t> active,
+                                            std::vector<std::uint8_t>& redundant)>;
+
+/// Alg. 1 peeling front faces in rounds: each round traces, for every unresolved ray, the nearest front
+/// face beyond the last redundant one (the fast culled path, 16-wide packets) and asks `mark` about all
+/// of them at once; a ray is resolved by its first non-redundant face or a miss.
+void trace_in_rounds(const SampledScene& scene, Span<const mesh::RayF> rays, Span<mesh::Hit> hits,
+                     const mesh::QueryOptions& culled, const RedundancyMarker& mark) {
+  std::vector<mesh::RayF> current(rays.begin(), rays.end()), batch;
+  std::vector<std::size_t> active(rays.size());
+  for (std::size_t i = 0; i < rays.size(); ++i) active[i] = i;
+  std::vector<mesh::Hit> found;
+  std::vector<std::uint8_t> redundant;
+  // Beyond a redundant face the nearest face is often a back face (the far side of a slab or box),
+  // which makes the two-pass culled query trace twice: later rounds cull inside one traversal, which
+  // a filter that accepts everything selects.
+  const mesh::HitFilter accept_all = [](const mesh::HitCandidate&) { return true; };
+  mesh::QueryOptions culled_once = culled;
+  culled_once.filter = &accept_all;
+  for (bool is_first = true; !active.empty(); is_first = false) {
+    batch.clear();
+    for (std::size_t a : active) batch.push_back(current[a]);
+    found.assign(batch.size(), mesh::Hit{});
+    scene.rays().intersect(Span<const mesh::RayF>(batch), Span<mesh::Hit>(found), is_first ? culled : culled_once);
+    redundant.assign(active.size(), 0);
+    mark(Span<const mesh::Hit>(found), Span<const std::size_t>(active), redundant);
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < active.size(); ++k) {
+      const std::size_t a = active[k];
+      if (!found[k].is_hit() || !redundant[k]) {
+        hits[a] = found[k];
+        continue;
+      }
+      // Beyond this face; a second report of the same point (a shared edge) is the same sample.
+      const float t = found[k].t;
+      current[a].t_near = std::max(std::nextafter(t, kInfinityF), t * (1.0f + kSameHitRelative));
+      active[kept++] = a;
+    }
+    active.resize(kept);
+  }
+}
+
+/// Visibility (Alg. 2 or its frustum variant) of a round's faces: coherent occlusion packets
+/// (rtcOccluded16), one earlier camera at a time so a packet's rays share their origin, and only for
+/// faces no earlier camera has shown redundant; a face facing away from the eye (or, for the frustum
+/// variant, outside the frustum) needs no ray.
+RedundancyMarker visibility_marker(const SampledScene& scene, const ImageRule& rule, Span<const mesh::RayF> rays,
+                                   bool is_coherent) {
+  return [&scene, &rule, rays, is_coherent](Span<const mesh::Hit> found, Span<const std::size_t> active,
+                                            std::vector<std::uint8_t>& redundant) {
+    const Redundancy redundancy = redundancy_of(rule.mode);
+    mesh::QueryOptions occluders;
+    occluders.cull_back_faces = true;  // back faces do not occlude: the culled images cannot show them
+    occluders.is_coherent = is_coherent;
+    std::vector<mesh::RayF> shadow;
+    std::vector<std::size_t> owner;
+    std::vector<std::uint8_t> blocked;
+    for (const Camera& cam : rule.previous_cameras) {
+      const Vec3f eye(cam.eye());
+      shadow.clear();
+      owner.clear();
+      for (std::size_t k = 0; k < active.size(); ++k) {
+        if (!found[k].is_hit() || redundant[k]) continue;
+        const Vec3f x = sample_position(rays[active[k]], found[k].t);
+        if (!may_be_visibility_redundant(scene, cam, redundancy, x, found[k].triangle_id)) continue;
+        shadow.push_back({eye, x - eye, 0.0f, 1.0f - float(tol::kSegmentEndRelative)});
+        owner.push_back(k);
+      }
+      blocked.assign(shadow.size(), 0);
+      scene.rays().occluded(Span<const mesh::RayF>(shadow), Span<std::uint8_t>(blocked), occluders);
+      for (std::size_t r = 0; r < shadow.size(); ++r)
+        if (!blocked[r]) redundant[owner[r]] = 1;
+    }
+  };
+}
+
+}  // namespace
 
 void trace(const SampledScene& scene, const ImageRule& rule, Span<const mesh::RayF> rays, Span<mesh::Hit> hits,
            bool is_coherent) {
@@ -109,48 +203,19 @@ void trace(const SampledScene& scene, const ImageRule& rule, Span<const mesh::Ra
         return true;
       };
       // The filter is pure, but QueryOptions::is_filter_pure stays off: redundancy rejects 15-50 % of
-      // the nearest hits of later images, and re-tracing those measured slower than one filtered pass.
+      // the nearest hits of later images, and re-tracing those (from scratch, or in rounds beyond the
+      // rejected face as visibility does) measured slower than one filtered pass: 1.7x vs 1.4x on grass.
       options.filter = &keep_non_redundant;
       scene.rays().intersect(rays, hits, options);
       return;
     }
-    case SamplingMode::NrrVisibility: {
+    case SamplingMode::NrrVisibility:
+    case SamplingMode::NrrVisibilityFrustum: {
       if (rule.previous_cameras.empty()) {
         scene.rays().intersect(rays, hits, options);
         return;
       }
-      // A candidate outside every earlier frustum, or facing away from every earlier eye, is surely
-      // non-redundant and is accepted at once (pruning the traversal); the others are collected and
-      // tested with occlusion rays after the traversal, nearest first.
-      std::vector<std::vector<Candidate>> maybe(rays.size());
-      const mesh::HitFilter collect = [&](const mesh::HitCandidate& c) {
-        const Vec3f x = sample_position(rays[c.ray_index], c.t);
-        for (const Camera& cam : rule.previous_cameras)
-          if (may_be_visible_from(scene, cam, x, c.triangle_id)) {
-            maybe[c.ray_index].push_back(to_candidate(c));
-            return false;
-          }
-        return true;
-      };
-      options.filter = &collect;
-      scene.rays().intersect(rays, hits, options);
-      for (std::size_t i = 0; i < rays.size(); ++i) {
-        std::vector<Candidate>& list = maybe[i];
-        std::sort(list.begin(), list.end());
-        list.erase(std::unique(list.begin(), list.end(),
-                               [](const Candidate& a, const Candidate& b) { return a.id == b.id; }),
-                   list.end());
-        for (const Candidate& c : list) {
-          if (!(c.t < hits[i].t)) break;
-          const Vec3f x = sample_position(rays[i], c.t);
-          const bool is_redundant = std::any_of(rule.previous_cameras.begin(), rule.previous_cameras.end(),
-                                                [&](const Camera& cam) { return visible_from(scene, cam, x, c.id); });
-          if (!is_redundant) {
-            hits[i] = to_hit(scene, c);
-            break;
-          }
-        }
-      }
+      trace_in_rounds(scene, rays, hits, options, visibility_marker(scene, rule, rays, is_coherent));
       return;
     }
     case SamplingMode::Peel: {
@@ -181,17 +246,10 @@ void trace_layers(const SampledScene& scene, int k, Span<const mesh::RayF> rays,
       layers[l * rays.size() + i] = l < nearest[i].size() ? to_hit(scene, nearest[i][l]) : mesh::Hit{};
 }
 
-void for_each_tile(const Camera& camera, bool threaded,
+void for_each_tile(const DepthImage& image, bool threaded,
                    const std::function<void(Span<const mesh::RayF> rays, Span<const std::size_t> pixels)>& fn) {
-  const int w = camera.width(), h = camera.height();
+  const int w = image.width, h = image.height;
   const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
-  const Vec3f eye(camera.eye());
-  // Directions are separable: forward + sx(x) * right + sy(y) * up, so a tile needs one column and one
-  // row term per pixel instead of a full camera evaluation.
-  std::vector<Vec3d> column(static_cast<std::size_t>(w)), row(static_cast<std::size_t>(h));
-  const Vec3d centre = camera.direction_unit_depth(0.5 * w, 0.5 * h);
-  for (int x = 0; x < w; ++x) column[std::size_t(x)] = camera.direction_unit_depth(x + 0.5, 0.5 * h) - centre;
-  for (int y = 0; y < h; ++y) row[std::size_t(y)] = camera.direction_unit_depth(0.5 * w, y + 0.5);
   const auto run = [&](int tile) {
     std::vector<mesh::RayF> rays;
     std::vector<std::size_t> pixels;
@@ -202,28 +260,12 @@ void for_each_tile(const Camera& camera, bool threaded,
       for (int bx = x0; bx < std::min(x0 + kTile, w); bx += kBlock)
         for (int y = by; y < std::min(by + kBlock, h); ++y)
           for (int x = bx; x < std::min(bx + kBlock, w); ++x) {
-            rays.push_back({eye, Vec3f(row[std::size_t(y)] + column[std::size_t(x)])});
+            rays.push_back({image.rays.origin(), image.rays.direction(std::size_t(x), std::size_t(y))});
             pixels.push_back(std::size_t(y) * std::size_t(w) + std::size_t(x));
           }
     fn(Span<const mesh::RayF>(rays), Span<const std::size_t>(pixels));
   };
-  const int tiles = tiles_x * tiles_y;
-  if (!threaded) {
-    for (int t = 0; t < tiles; ++t) run(t);
-    return;
-  }
-  tbb::parallel_for(tbb::blocked_range<int>(0, tiles), [&](const tbb::blocked_range<int>& r) {
-    for (int t = r.begin(); t < r.end(); ++t) run(t);
-  });
-}
-
-void store_sample(const SampledScene& scene, const mesh::RayF& ray, const mesh::Hit& h, std::size_t pixel,
-                  DepthImage& image) {
-  if (!h.is_hit()) return;
-  image.depth[pixel] = h.t;
-  image.triangle_id[pixel] = h.triangle_id;
-  image.normal_ws[pixel] = scene.shading_normal(h.triangle_id, h.u, h.v, h.normal_ws);
-  image.position_ws[pixel] = sample_position(ray, h.t);
+  parallel_for_each(tiles_x * tiles_y, run, threaded);
 }
 
 }  // namespace raysift::nrr::detail

@@ -9,11 +9,8 @@
 
 namespace raysift::nrr::detail {
 
-/// The sample point of a hit along a ray, rounded to float exactly once so that the samplers and the
-/// metrics reproject the very same point.
-inline Vec3f sample_position(const mesh::RayF& ray, float t) {
-  return Vec3f(Vec3d(ray.origin) + Vec3d(ray.direction) * double(t));
-}
+/// The sample point of a hit along a ray (sample_point: rounded to float once).
+inline Vec3f sample_position(const mesh::RayF& ray, float t) { return sample_point(ray.origin, ray.direction, t); }
 
 /// Projection of world points to pixel indices of one camera, with the camera basis pre-scaled so a
 /// point costs three dot products and one division (the pixel-redundancy filter runs per candidate).
@@ -42,17 +39,31 @@ inline bool pixel_captured(const DepthImage& image, const Camera& camera, const 
   return pixel_captured(image, PixelProjector(camera), x, id);
 }
 
-/// Visibility (Alg. 2, plus the frustum [choice] of ALGORITHMS.md §10): `x` on triangle `id` lies in
-/// the camera's image, its face looks at the eye, and the segment eye -> x is unoccluded by front faces.
-bool visible_from(const SampledScene& scene, const Camera& camera, const Vec3f& x, mesh::TriangleId id);
-/// The cheap part of visible_from (frustum and facing), usable inside a filter.
-bool may_be_visible_from(const SampledScene& scene, const Camera& camera, const Vec3f& x, mesh::TriangleId id);
+/// x projects inside the camera's image (in front of the eye, within [0, w) x [0, h)).
+bool in_frustum(const Camera& camera, const Vec3f& x);
+/// x's face (triangle id) looks at `eye`: the culled images can only hold x from such an eye.
+bool faces_eye(const SampledScene& scene, const Vec3d& eye, const Vec3f& x, mesh::TriangleId id);
+/// Alg. 2: x is the first front face hit from `eye` toward x (it faces the eye and no front face
+/// occludes the segment; back faces do not occlude because every image culls them).
+bool line_of_sight(const SampledScene& scene, const Vec3d& eye, const Vec3f& x, mesh::TriangleId id);
+/// Visibility redundancy of x with the image of `camera`: line_of_sight, and for VisibilityFrustum
+/// also in_frustum. \pre redundancy is Visibility or VisibilityFrustum.
+bool visibility_redundant(const SampledScene& scene, const Camera& camera, Redundancy redundancy, const Vec3f& x,
+                          mesh::TriangleId id);
+/// The cheap part of visibility_redundant (facing and, for VisibilityFrustum, the frustum): false
+/// means surely not redundant. Usable inside a filter.
+bool may_be_visibility_redundant(const SampledScene& scene, const Camera& camera, Redundancy redundancy,
+                                 const Vec3f& x, mesh::TriangleId id);
+/// Whether a conventional image from `camera` holds x: in its frustum and in line of sight.
+inline bool visible_in_image(const SampledScene& scene, const Camera& camera, const Vec3f& x, mesh::TriangleId id) {
+  return visibility_redundant(scene, camera, Redundancy::VisibilityFrustum, x, id);
+}
 
 /// How one image picks its sample along a ray.
 struct ImageRule {
   SamplingMode mode = SamplingMode::Conventional;
   Span<const DepthImage> previous;  ///< nrr-pixel: the images before this one
-  Span<const Camera> previous_cameras;  ///< nrr-pixel and nrr-visibility: their cameras
+  Span<const Camera> previous_cameras;  ///< the NRR modes: their cameras
   int layer = 0;                    ///< peel: 0 = nearest front face
 };
 
@@ -65,14 +76,17 @@ void trace(const SampledScene& scene, const ImageRule& rule, Span<const mesh::Ra
 void trace_layers(const SampledScene& scene, int k, Span<const mesh::RayF> rays, Span<mesh::Hit> layers,
                   bool is_coherent);
 
-/// Calls fn(rays, pixels) for tiles of 16x16 pixels whose rays are ordered in 4x4 blocks (one packet
-/// each); rays have direction camera.direction_unit_depth, so t is view depth. Tiles run in parallel
+/// Calls fn(rays, pixels) for tiles of 16x16 pixels of `image` whose rays (image.rays, unit forward
+/// component, so t is view depth) are ordered in 4x4 blocks (one packet each). Tiles run in parallel
 /// when `threaded`; each tile writes only its own pixels.
-void for_each_tile(const Camera& camera, bool threaded,
+void for_each_tile(const DepthImage& image, bool threaded,
                    const std::function<void(Span<const mesh::RayF> rays, Span<const std::size_t> pixels)>& fn);
 
-/// Stores hit `h` of `ray` at `pixel` of `image` (shading normal, position, depth = t).
-void store_sample(const SampledScene& scene, const mesh::RayF& ray, const mesh::Hit& h, std::size_t pixel,
-                  DepthImage& image);
+/// Stores hit `h` at `pixel` of `image`: depth = t and the triangle id (the lean record).
+inline void store_sample(const mesh::Hit& h, std::size_t pixel, DepthImage& image) {
+  if (!h.is_hit()) return;
+  image.depth[pixel] = h.t;
+  image.triangle_id[pixel] = h.triangle_id;
+}
 
 }  // namespace raysift::nrr::detail
