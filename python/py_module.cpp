@@ -1,0 +1,72 @@
+// raysift._raysift: the extension behind `import raysift` (docs/python.md).
+#include "core/errors.h"
+#include "python/py_bindings.h"
+#include "python/py_common.h"
+
+namespace raysift::py {
+
+pyb::object to_python(const Json& j) {
+  switch (j.type()) {
+    case Json::value_t::object: {
+      pyb::dict d;
+      for (const auto& [key, value] : j.items()) d[pyb::str(key)] = to_python(value);
+      return std::move(d);
+    }
+    case Json::value_t::array: {
+      pyb::list l;
+      for (const Json& value : j) l.append(to_python(value));
+      return std::move(l);
+    }
+    case Json::value_t::string: return pyb::str(j.get<std::string>());
+    case Json::value_t::boolean: return pyb::bool_(j.get<bool>());
+    case Json::value_t::number_integer: return pyb::int_(j.get<std::int64_t>());
+    case Json::value_t::number_unsigned: return pyb::int_(j.get<std::uint64_t>());
+    case Json::value_t::number_float: return pyb::float_(j.get<double>());
+    default: return pyb::none();
+  }
+}
+
+std::array<double, 3> triple(const pyb::handle& value, const char* what) {
+  try {
+    const auto v = value.cast<std::vector<double>>();
+    if (v.size() == 3) return {v[0], v[1], v[2]};
+  } catch (const pyb::cast_error&) {
+  }
+  throw pyb::type_error(std::string(what) + " must be a sequence of 3 numbers, got " +
+                        pyb::repr(value).cast<std::string>());
+}
+
+namespace {
+
+void register_exceptions(pyb::module_& m) {
+  static pyb::exception<InvalidInput> invalid(m, "InvalidInput", PyExc_ValueError);
+  static pyb::exception<IoError> io(m, "IOError", PyExc_OSError);
+  pyb::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const InvalidInput& e) {
+      PyErr_SetString(invalid.ptr(), e.what());
+    } catch (const UsageError& e) {  // a bad keyword value, as the CLI's bad flag value
+      PyErr_SetString(invalid.ptr(), e.what());
+    } catch (const IoError& e) {
+      PyErr_SetString(io.ptr(), e.what());
+    } catch (const ResourceError& e) {
+      PyErr_SetString(PyExc_MemoryError, e.what());
+    } catch (const Cancelled& e) {
+      PyErr_SetString(PyExc_KeyboardInterrupt, e.what());
+    }
+  });
+}
+
+}  // namespace
+}  // namespace raysift::py
+
+PYBIND11_MODULE(_raysift, m) {
+  m.doc() = "raysift: prioritized volume ray casting; NumPy arrays in and out, indexed [z, y, x] / [row, column]";
+  m.attr("__version__") = RAYSIFT_VERSION;
+  raysift::py::register_exceptions(m);
+  raysift::py::bind_volumes(m);
+  raysift::py::bind_render(m);
+  raysift::py::bind_tools(m);
+  raysift::py::bind_sweep(m);
+}

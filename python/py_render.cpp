@@ -1,0 +1,159 @@
+// raysift.render and raysift.Renderer: `raysift render` on in-memory inputs, returning (image, stats).
+#include "python/py_render.h"
+
+#include <tbb/global_control.h>
+
+#include <optional>
+
+#include "apps/raysift/sampling_stats.h"
+#include "core/errors.h"
+#include "core/timer.h"
+#include "python/py_bindings.h"
+#include "python/py_common.h"
+
+namespace raysift::py {
+
+volume::RenderOptions caster_options(const RenderKeywords& k) {
+  if (k.shading != "none" && k.shading != "phong")
+    throw InvalidInput("shading must be \"none\" or \"phong\", got \"" + k.shading + "\"");
+  volume::RenderOptions o;
+  o.step_voxels = k.step;
+  o.shading = k.shading == "phong" ? volume::Shading::Phong : volume::Shading::None;
+  o.background = {float(k.background[0]), float(k.background[1]), float(k.background[2])};
+  o.seed = k.seed;
+  return o;
+}
+
+sampling::SampledRenderRequest sampled_request(const RenderKeywords& k) {
+  sampling::SampledRenderRequest r;
+  r.sampling.mode = sampling::parse_sampling_mode(k.mode);
+  if (k.ray_fraction) r.sampling.ray_fraction = *k.ray_fraction;
+  if (k.budget_ms) r.sampling.budget_ms = *k.budget_ms;
+  r.sampling.seed = k.seed;
+  if (k.alpha) {
+    if (k.alpha->size() != r.sampling.mapping.alpha.size())
+      throw InvalidInput("alpha must hold 6 numbers a00,a10,a01,a11,a20,a02, got " + std::to_string(k.alpha->size()));
+    std::copy(k.alpha->begin(), k.alpha->end(), r.sampling.mapping.alpha.begin());
+  }
+  r.features.classes = sampling::parse_feature_list(k.features);
+  sampling::validate(r.sampling);
+  return r;
+}
+
+RenderSession::RenderSession(volume::Volume volume, volume::TransferFunction tf)
+    : volume_(std::move(volume)),
+      tf_(std::move(tf)),
+      bricks_(volume::build_volume_bricks(volume_)),
+      cache_(std::make_shared<isosurface::FeatureCache>()) {}
+
+namespace {
+
+/// The stats of `raysift render --stats` around a mode's own keys (a duplicate of the object cmd_render.cpp builds
+/// inline; the lead folds the two after merging).
+Json render_stats(const std::string& mode, const volume::RayCaster& caster, std::uint64_t rays, std::uint64_t samples,
+                  double setup_ms, double trace_ms, double total_ms, const Json& extra) {
+  Json stats = {{"mode", mode},
+                {"width", caster.width()},
+                {"height", caster.height()},
+                {"rays_traced", rays},
+                {"samples", samples},
+                {"step_voxels", caster.options().step_voxels},
+                {"skip_empty_space", caster.options().skip_empty_space},
+                {"visible_blocks", caster.visible_block_count()},
+                {"times_ms", {{"setup", setup_ms}, {"trace", trace_ms}, {"frame", trace_ms}, {"total", total_ms}}}};
+  stats.merge_patch(extra);
+  return stats;
+}
+
+}  // namespace
+
+RenderOutput RenderSession::render(const CameraSpec& camera, const RenderKeywords& k,
+                                   const std::atomic<bool>& cancel) const {
+  const Timer total;
+  if (k.mode != "full" && k.mode != "prioritized" && k.mode != "subsample")
+    throw InvalidInput("mode must be \"full\", \"prioritized\" or \"subsample\", got \"" + k.mode + "\"");
+  if (k.budget_ms && *k.budget_ms > 0 && k.mode != "prioritized")  // the CLI's --budget-ms rule
+    throw InvalidInput("budget_ms needs mode=\"prioritized\", got mode=\"" + k.mode + "\"");
+  if (k.threads < 0) throw InvalidInput("threads must be >= 0, got " + std::to_string(k.threads));
+  std::optional<tbb::global_control> limit;
+  if (k.threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(k.threads));
+  const volume::RayCaster caster(volume_, bricks_, tf_, camera, caster_options(k));
+  const double setup_ms = total.elapsed_ms();
+  const Timer trace;
+  if (k.mode == "full") {
+    volume::RenderResult r = volume::render_full(caster, [&cancel](double) {
+      if (cancel.load(std::memory_order_relaxed)) throw Cancelled("interrupted by SIGINT");
+    });
+    const double trace_ms = trace.elapsed_ms();
+    Json stats = render_stats(k.mode, caster, r.rays_traced, r.samples, setup_ms, trace_ms, total.elapsed_ms(), Json::object());
+    return {std::move(r.image), std::move(stats)};
+  }
+  sampling::SampledRenderRequest request = sampled_request(k);
+  request.geometry.cancel = &cancel;
+  request.feature_cache = cache_.get();
+  sampling::SampledRender r = sampling::render_sampled_volume(volume_, tf_, caster, request);
+  const double trace_ms = trace.elapsed_ms();
+  const Json extra = app::sampled_render_json(r, request.sampling.budget_ms);
+  Json stats = render_stats(k.mode, caster, r.rays_traced, r.samples, setup_ms, trace_ms, total.elapsed_ms(), extra);
+  return {std::move(r.image), std::move(stats)};
+}
+
+namespace {
+
+/// (H, W, 4) float32 over the image's own buffer.
+pyb::array_t<float> image_array(ImageRGBA&& image) {
+  auto owner = std::make_unique<ImageRGBA>(std::move(image));
+  const float* data = &owner->pixels.data()->r;
+  const pyb::ssize_t h = owner->height, w = owner->width;
+  return owning_array(std::move(owner), data, {h, w, 4});
+}
+
+pyb::tuple render_with(const RenderSession& session, const CameraSpec& camera, const RenderKeywords& k) {
+  RenderOutput out = run_released([&](const std::atomic<bool>& cancel) { return session.render(camera, k, cancel); });
+  return pyb::make_tuple(image_array(std::move(out.image)), to_python(out.stats));
+}
+
+RenderKeywords keywords(const std::string& mode, std::optional<double> ray_fraction, std::optional<double> budget_ms,
+                        const std::string& features, std::optional<std::vector<float>> alpha,
+                        const std::string& shading, double step, const pyb::object& background, int threads,
+                        std::uint64_t seed) {
+  RenderKeywords k;
+  k.mode = mode;
+  k.ray_fraction = ray_fraction;
+  k.budget_ms = budget_ms;
+  k.features = features;
+  k.alpha = std::move(alpha);
+  k.shading = shading;
+  k.step = step;
+  k.background = triple(background, "background");
+  k.threads = threads;
+  k.seed = seed;
+  return k;
+}
+
+}  // namespace
+
+void bind_render(pyb::module_& m) {
+  // raysift.render(volume, tf, camera, **kw) is Renderer(volume, tf).render(camera, **kw), in __init__.py.
+  pyb::class_<RenderSession>(m, "Renderer",
+                             "A volume and TF with the caster's bricks and the feature geometry kept across renders.")
+      .def(pyb::init([](const volume::Volume& v, const volume::TransferFunction& tf) {
+             return run_released([&](const std::atomic<bool>&) { return std::make_unique<RenderSession>(v, tf); });
+           }),
+           pyb::arg("volume"), pyb::arg("tf"))
+      .def(
+          "render",
+          [](const RenderSession& s, const CameraSpec& camera, const std::string& mode,
+             std::optional<double> ray_fraction, std::optional<double> budget_ms, const std::string& features,
+             std::optional<std::vector<float>> alpha, const std::string& shading, double step,
+             const pyb::object& background, int threads, std::uint64_t seed) {
+            return render_with(s, camera, keywords(mode, ray_fraction, budget_ms, features, std::move(alpha), shading,
+                                                   step, background, threads, seed));
+          },
+          pyb::arg("camera"), pyb::kw_only(), pyb::arg("mode") = "full", pyb::arg("ray_fraction") = pyb::none(),
+          pyb::arg("budget_ms") = pyb::none(), pyb::arg("features") = RenderKeywords{}.features,
+          pyb::arg("alpha") = pyb::none(), pyb::arg("shading") = "none", pyb::arg("step") = RenderKeywords{}.step,
+          pyb::arg("background") = pyb::make_tuple(0, 0, 0), pyb::arg("threads") = 0, pyb::arg("seed") = 1);
+}
+
+}  // namespace raysift::py
