@@ -1,18 +1,19 @@
 #pragma once
 /// \file What every binding file shares: JSON <-> Python, capsule-owned NumPy arrays, and running raysift with the
-/// GIL released while Ctrl-C stays live (docs/python.md "Behaviour").
+/// GIL released while Ctrl-C stays live (docs/python.md "Conventions").
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>  // every file: the same std::vector/optional casters everywhere
 
 #include <array>
 #include <atomic>
-#include <chrono>
-#include <future>
+#include <optional>
+#include <type_traits>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "core/errors.h"
 #include "core/json_io.h"
 
 namespace raysift::py {
@@ -39,29 +40,51 @@ pyb::array_t<T> vector_array(std::vector<T>&& values, std::vector<pyb::ssize_t> 
   return owning_array(std::move(owner), data, std::move(shape));
 }
 
-/// Python threads keep running while `work(cancel)` computes on a helper thread; the calling thread wakes every
-/// 50 ms to let Python see signals. On Ctrl-C it sets `cancel` (the stages poll it and throw Cancelled), waits for
-/// the work to unwind and raises KeyboardInterrupt; C++ exceptions of the work propagate to the translators.
+/// While at least one exists, SIGINT sets `flag()` (the stages poll it and throw Cancelled) and is then passed on to
+/// the handler it replaced (Python's: it raises KeyboardInterrupt at the next check; SIG_DFL: the process ends).
+/// [choice] Not core/signals' flag: that one never resets (right for a process that exits) and its handler would
+/// take SIGINT from Python for good. Not a helper thread polling PyErr_CheckSignals either: handing the result
+/// back to a sleeping thread cost 2-3 ms per call on the loaded 2-core machine.
+class InterruptScope {
+ public:
+  InterruptScope();
+  ~InterruptScope();
+  InterruptScope(const InterruptScope&) = delete;
+  InterruptScope& operator=(const InterruptScope&) = delete;
+  static const std::atomic<bool>& flag();
+};
+
+/// Runs `work(cancel)` on the calling thread with the GIL released (other Python threads keep running). A Ctrl-C
+/// during it stops the work and raises KeyboardInterrupt (through Python's own handler) when it returns; C++
+/// exceptions of the work propagate to the translators.
 template <typename Work>
-auto run_released(Work&& work) -> decltype(work(std::declval<const std::atomic<bool>&>())) {
-  std::atomic<bool> cancel{false};
-  PyObject *type = nullptr, *value = nullptr, *trace = nullptr;
-  auto done = std::async(std::launch::async, [&] { return work(cancel); });
-  {
-    pyb::gil_scoped_release release;
-    while (done.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
-      pyb::gil_scoped_acquire gil;
-      if (!type && PyErr_CheckSignals() != 0) {
-        PyErr_Fetch(&type, &value, &trace);
-        cancel = true;
+auto run_released(Work&& work) {
+  using Result = decltype(work(InterruptScope::flag()));
+  std::optional<InterruptScope> scope(std::in_place);
+  auto finish = [&scope] {
+    scope.reset();
+    if (PyErr_CheckSignals() != 0) throw pyb::error_already_set();  // KeyboardInterrupt, or the user's handler
+  };
+  try {
+    if constexpr (std::is_void_v<Result>) {
+      {
+        pyb::gil_scoped_release release;
+        work(InterruptScope::flag());
       }
+      finish();
+    } else {
+      std::optional<Result> result;
+      {
+        pyb::gil_scoped_release release;
+        result.emplace(work(InterruptScope::flag()));
+      }
+      finish();
+      return std::move(*result);
     }
+  } catch (const Cancelled&) {
+    finish();
+    throw;
   }
-  if (type) {
-    PyErr_Restore(type, value, trace);
-    throw pyb::error_already_set();
-  }
-  return done.get();
 }
 
 /// (3,) floats from a sequence. \throw TypeError naming `what`.

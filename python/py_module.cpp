@@ -1,4 +1,7 @@
 // raysift._raysift: the extension behind `import raysift` (docs/python.md).
+#include <csignal>
+#include <mutex>
+
 #include "core/errors.h"
 #include "python/py_bindings.h"
 #include "python/py_common.h"
@@ -35,6 +38,46 @@ std::array<double, 3> triple(const pyb::handle& value, const char* what) {
   throw pyb::type_error(std::string(what) + " must be a sequence of 3 numbers, got " +
                         pyb::repr(value).cast<std::string>());
 }
+
+namespace {
+
+std::mutex g_scope_mutex;
+int g_scopes = 0;                    ///< InterruptScopes alive
+struct sigaction g_replaced {};      ///< the SIGINT action the first scope replaced; read-only while installed
+std::atomic<bool> g_interrupted{false};
+
+extern "C" void on_interrupt(int signo, siginfo_t* info, void* context) {
+  if (!(g_replaced.sa_flags & SA_SIGINFO) && g_replaced.sa_handler == SIG_IGN) return;
+  g_interrupted.store(true);
+  if (g_replaced.sa_flags & SA_SIGINFO) {
+    g_replaced.sa_sigaction(signo, info, context);
+  } else if (g_replaced.sa_handler == SIG_DFL) {
+    sigaction(signo, &g_replaced, nullptr);  // the process was meant to end on Ctrl-C: let it
+    raise(signo);
+  } else {
+    g_replaced.sa_handler(signo);
+  }
+}
+
+}  // namespace
+
+InterruptScope::InterruptScope() {
+  const std::lock_guard<std::mutex> lock(g_scope_mutex);
+  if (g_scopes++ > 0) return;
+  g_interrupted.store(false);
+  struct sigaction action {};
+  action.sa_sigaction = on_interrupt;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_SIGINFO | SA_ONSTACK;  // Python's own flags: no SA_RESTART, its I/O retries EINTR itself
+  sigaction(SIGINT, &action, &g_replaced);
+}
+
+InterruptScope::~InterruptScope() {
+  const std::lock_guard<std::mutex> lock(g_scope_mutex);
+  if (--g_scopes == 0) sigaction(SIGINT, &g_replaced, nullptr);
+}
+
+const std::atomic<bool>& InterruptScope::flag() { return g_interrupted; }
 
 namespace {
 

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "core/camera.h"
+#include "core/parallel.h"
 #include "core/errors.h"
 #include "python/py_bindings.h"
 #include "python/py_common.h"
@@ -80,11 +81,13 @@ pyb::array_t<float> to_numpy(const Volume& v) {
   if (info.active_voxels == 0) return pyb::array_t<float>(std::vector<pyb::ssize_t>{0, 0, 0});
   const Vec3i lo = info.index_min, n = info.index_max - info.index_min + Vec3i{1, 1, 1};
   auto values = std::make_unique<std::vector<float>>(std::size_t(n.x) * std::size_t(n.y) * std::size_t(n.z));
+  float* out = values->data();
   run_released([&](const std::atomic<bool>&) {
-    std::size_t i = 0;
-    for (int k = 0; k < n.z; ++k)
+    parallel_for_each(n.z, [&](int k) {  // each z-slice writes its own part of the array
+      std::size_t i = std::size_t(k) * std::size_t(n.x) * std::size_t(n.y);
       for (int j = 0; j < n.y; ++j)
-        for (int x = 0; x < n.x; ++x) (*values)[i++] = v.value_at({lo.x + x, lo.y + j, lo.z + k});
+        for (int x = 0; x < n.x; ++x) out[i++] = v.value_at({lo.x + x, lo.y + j, lo.z + k});
+    });
   });
   const float* data = values->data();
   return owning_array(std::move(values), data, {n.z, n.y, n.x});
