@@ -52,6 +52,8 @@ class RenderSession {
   const volume::TransferFunction& tf() const { return tf_; }
 
  private:
+  RenderOutput render_frame(const CameraSpec& camera, const RenderKeywords& k, const std::atomic<bool>& cancel) const;
+
   volume::Volume volume_;
   volume::TransferFunction tf_;
   std::shared_ptr<const volume::VolumeBricks> bricks_;
