@@ -93,7 +93,7 @@ RenderOutput RenderSession::render_frame(const CameraSpec& camera, const RenderK
     });
     const double trace_ms = trace.elapsed_ms();
     Json stats = render_stats(k.mode, caster, r.rays_traced, r.samples, setup_ms, trace_ms, total.elapsed_ms(), Json::object());
-    return {std::move(r.image), std::move(stats)};
+    return {std::move(r.image), std::move(stats), {}};
   }
   sampling::SampledRenderRequest request = sampled_request(k);
   request.geometry.cancel = &cancel;
@@ -102,7 +102,14 @@ RenderOutput RenderSession::render_frame(const CameraSpec& camera, const RenderK
   const double trace_ms = trace.elapsed_ms();
   const Json extra = app::sampled_render_json(r, request.sampling.budget_ms);
   Json stats = render_stats(k.mode, caster, r.rays_traced, r.samples, setup_ms, trace_ms, total.elapsed_ms(), extra);
-  return {std::move(r.image), std::move(stats)};
+  std::vector<std::string> warnings;  // cmd_render.cpp's warnings, in the keywords' names
+  if (r.features_skipped)
+    warnings.push_back("the transfer function is transparent over the whole data range; no surface feeds the feature "
+                       "lines, rendering without them");
+  if (r.any_budget_too_small)
+    warnings.push_back("budget_ms " + std::to_string(request.sampling.budget_ms) +
+                       " is below the time of the level-0 pattern plus reconstruction; only level 0 was traced");
+  return {std::move(r.image), std::move(stats), std::move(warnings)};
 }
 
 namespace {
@@ -117,6 +124,8 @@ pyb::array_t<float> image_array(ImageRGBA&& image) {
 
 pyb::tuple render_with(const RenderSession& session, const CameraSpec& camera, const RenderKeywords& k) {
   RenderOutput out = run_released([&](const std::atomic<bool>& cancel) { return session.render(camera, k, cancel); });
+  for (const std::string& w : out.warnings)
+    if (PyErr_WarnEx(PyExc_RuntimeWarning, w.c_str(), 1) != 0) throw pyb::error_already_set();  // warnings as errors
   return pyb::make_tuple(image_array(std::move(out.image)), to_python(out.stats));
 }
 

@@ -40,6 +40,7 @@ sampling::SampledRenderRequest sampled_request(const RenderKeywords& k);
 struct RenderOutput {
   ImageRGBA image;  ///< premultiplied RGBA as in the EXR (colour composited over the background)
   Json stats;       ///< the keys of `raysift render --stats`
+  std::vector<std::string> warnings;  ///< what the CLI prints as "raysift: warning: ..." (Python: RuntimeWarning)
 };
 
 /// A volume and TF with their camera-independent state: the caster's bricks and the feature geometry cache.

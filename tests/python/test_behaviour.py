@@ -139,3 +139,11 @@ def test_memory_does_not_grow_over_200_renders(volume, tf):
     del image, stats
     gc.collect()
     assert rss_bytes() - before < 4 * 1024 * 1024
+
+
+def test_the_cli_warnings_are_runtime_warnings(volume, tf, camera):
+    invisible = raysift.TransferFunction.from_points([0.0, 1.0], [[1, 1, 1], [1, 1, 1]], [0.0, 0.0])
+    with pytest.warns(RuntimeWarning, match="transparent over the whole data range"):
+        raysift.render(volume, invisible, camera, mode="prioritized", ray_fraction=0.5)
+    with pytest.warns(RuntimeWarning, match="only level 0 was traced"):
+        raysift.render(volume, tf, camera, mode="prioritized", budget_ms=1e-6)
