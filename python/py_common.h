@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/image.h"
 #include "core/json_io.h"
 
 namespace raysift::py {
@@ -32,7 +33,10 @@ pyb::array_t<T> owning_array(std::unique_ptr<Owner> owner, const T* data, std::v
   return pyb::array_t<T>(shape, data, base);
 }
 
-/// A 1-D vector's buffer moved into an array without a copy.
+/// (H, W, 4) float32 over the image's own buffer (row 0 at the top).
+pyb::array_t<float> image_array(ImageRGBA&& image);
+
+/// A vector's buffer moved into an array without a copy.
 template <typename T>
 pyb::array_t<T> vector_array(std::vector<T>&& values, std::vector<pyb::ssize_t> shape) {
   auto owner = std::make_unique<std::vector<T>>(std::move(values));

@@ -29,6 +29,13 @@ pyb::object to_python(const Json& j) {
   }
 }
 
+pyb::array_t<float> image_array(ImageRGBA&& image) {
+  auto owner = std::make_unique<ImageRGBA>(std::move(image));
+  const float* data = &owner->pixels.data()->r;
+  const pyb::ssize_t h = owner->height, w = owner->width;
+  return owning_array(std::move(owner), data, {h, w, 4});
+}
+
 std::array<double, 3> triple(const pyb::handle& value, const char* what) {
   try {
     const auto v = value.cast<std::vector<double>>();

@@ -114,14 +114,6 @@ RenderOutput RenderSession::render_frame(const CameraSpec& camera, const RenderK
 
 namespace {
 
-/// (H, W, 4) float32 over the image's own buffer.
-pyb::array_t<float> image_array(ImageRGBA&& image) {
-  auto owner = std::make_unique<ImageRGBA>(std::move(image));
-  const float* data = &owner->pixels.data()->r;
-  const pyb::ssize_t h = owner->height, w = owner->width;
-  return owning_array(std::move(owner), data, {h, w, 4});
-}
-
 pyb::tuple render_with(const RenderSession& session, const CameraSpec& camera, const RenderKeywords& k) {
   RenderOutput out = run_released([&](const std::atomic<bool>& cancel) { return session.render(camera, k, cancel); });
   for (const std::string& w : out.warnings)
@@ -152,7 +144,7 @@ RenderKeywords keywords(const std::string& mode, std::optional<double> ray_fract
 void bind_render(pyb::module_& m) {
   // raysift.render(volume, tf, camera, **kw) is Renderer(volume, tf).render(camera, **kw), in __init__.py.
   pyb::class_<RenderSession>(m, "Renderer",
-                             "A volume and TF with the caster's bricks and the feature geometry kept across renders.")
+                             "A volume and TF with the caster's bricks and an in-memory feature-geometry cache kept across renders.")
       .def(pyb::init([](const volume::Volume& v, const volume::TransferFunction& tf) {
              return run_released([&](const std::atomic<bool>&) { return std::make_unique<RenderSession>(v, tf); });
            }),

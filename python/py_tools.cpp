@@ -211,10 +211,7 @@ pyb::tuple lines(const FloatArray& vertices,
 }
 
 pyb::array_t<float> read_image(const std::string& path) {
-  auto image = std::make_unique<ImageRGBA>(run_released([&](const std::atomic<bool>&) { return read_image_rgba(path); }));
-  const float* data = &image->pixels.data()->r;
-  const pyb::ssize_t h = image->height, w = image->width;
-  return owning_array(std::move(image), data, {h, w, 4});
+  return image_array(run_released([&](const std::atomic<bool>&) { return read_image_rgba(path); }));
 }
 
 }  // namespace
