@@ -1,0 +1,64 @@
+#pragma once
+/// \file The render keywords and the session both raysift.render and raysift.Renderer use, so the two give the
+/// same (image, stats) by construction; py_tools.cpp's sweep reuses the keyword mapping.
+#include <array>
+#include <atomic>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/camera.h"
+#include "core/image.h"
+#include "core/json_io.h"
+#include "isosurface/feature_cache.h"
+#include "sampling/volume_sampling.h"
+#include "volume/raycaster.h"
+#include "volume/transfer_function.h"
+#include "volume/volume.h"
+
+namespace raysift::py {
+
+/// The keywords of raysift.render; defaults are the CLI's (RenderCliOptions).
+struct RenderKeywords {
+  std::string mode = "full";  ///< full | prioritized | subsample
+  std::optional<double> ray_fraction, budget_ms;
+  std::string features = "contours,silhouettes";
+  std::optional<std::vector<float>> alpha;  ///< a00,a10,a01,a11,a20,a02
+  std::string shading = "none";
+  double step = volume::RenderOptions{}.step_voxels;
+  std::array<double, 3> background{0, 0, 0};
+  int threads = 0;
+  std::uint64_t seed = 1;
+};
+
+/// What `raysift render --shading S --step X --background R,G,B --seed N` sets. \throw InvalidInput.
+volume::RenderOptions caster_options(const RenderKeywords& k);
+/// What `--mode M --ray-fraction F --budget-ms B --features L --alpha A --seed N` sets. \throw InvalidInput.
+sampling::SampledRenderRequest sampled_request(const RenderKeywords& k);
+
+struct RenderOutput {
+  ImageRGBA image;  ///< premultiplied RGBA as in the EXR (colour composited over the background)
+  Json stats;       ///< the keys of `raysift render --stats`
+  std::vector<std::string> warnings;  ///< what the CLI prints as "raysift: warning: ..." (Python: RuntimeWarning)
+};
+
+/// A volume and TF with their camera-independent state: the caster's bricks and the feature geometry cache.
+class RenderSession {
+ public:
+  RenderSession(volume::Volume volume, volume::TransferFunction tf);
+  /// One `raysift render` of this volume and TF; stops with Cancelled once `cancel` is set.
+  RenderOutput render(const CameraSpec& camera, const RenderKeywords& k, const std::atomic<bool>& cancel) const;
+  const volume::Volume& volume() const { return volume_; }
+  const volume::TransferFunction& tf() const { return tf_; }
+
+ private:
+  RenderOutput render_frame(const CameraSpec& camera, const RenderKeywords& k, const std::atomic<bool>& cancel) const;
+
+  volume::Volume volume_;
+  volume::TransferFunction tf_;
+  std::shared_ptr<const volume::VolumeBricks> bricks_;
+  std::shared_ptr<isosurface::FeatureCache> cache_;  ///< memory only; thread-safe
+};
+
+}  // namespace raysift::py
