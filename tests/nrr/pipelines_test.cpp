@@ -46,7 +46,9 @@ TEST(ShadowPipeline, MatchesTheStagesCalledByHand) {
   EXPECT_FALSE(run.reference_vs_raytrace);  // only a shadow-map reference is measured against shadow rays
   // Background pixels are black and opaque in the shaded picture.
   for (std::size_t p = 0; p < rec.is_hit.size(); ++p) {
-    if (!rec.is_hit[p]) EXPECT_EQ(run.shaded.pixels[p], (Rgba{0, 0, 0, 1}));
+    if (!rec.is_hit[p]) {
+      EXPECT_EQ(run.shaded.pixels[p], (Rgba{0, 0, 0, 1}));
+    }
   }
 }
 
