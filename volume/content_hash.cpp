@@ -51,9 +51,8 @@ void add_transform(Hasher128& h, const openvdb::math::Transform& xform) {
   }
 }
 
-}  // namespace
-
-Hash128 content_hash(const Volume& volume, bool threaded) {
+/// The digest itself (content_hash memoizes it in the Volume).
+Hash128 compute_content_hash(const Volume& volume, bool threaded) {
   const openvdb::FloatGrid& grid = *volume.impl().grid;
   const Tree& tree = grid.tree();
   Hasher128 h;
@@ -89,6 +88,14 @@ Hash128 content_hash(const Volume& volume, bool threaded) {
   }
   h.u64(tiles);
   return h.digest();
+}
+
+}  // namespace
+
+Hash128 content_hash(const Volume& volume, bool threaded) {
+  const Volume::Impl& impl = volume.impl();
+  std::call_once(impl.hash_once, [&] { impl.content_hash = compute_content_hash(volume, threaded); });
+  return impl.content_hash;
 }
 
 }  // namespace raysift::volume

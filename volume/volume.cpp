@@ -150,14 +150,18 @@ GridInfo grid_base_info(const openvdb::GridBase& g) {
 }  // namespace detail
 
 GridInfo Volume::info() const {
-  const openvdb::FloatGrid& g = *impl_->grid;
-  GridInfo info = detail::grid_base_info(g);
-  info.background = g.background();
-  if (info.active_voxels == 0) return info;
-  const openvdb::math::MinMax<float> range = openvdb::tools::minMax(g.tree());
-  info.value_min = range.min();
-  info.value_max = range.max();
-  return info;
+  std::call_once(impl_->info_once, [this] {
+    const openvdb::FloatGrid& g = *impl_->grid;
+    GridInfo info = detail::grid_base_info(g);
+    info.background = g.background();
+    if (info.active_voxels > 0) {
+      const openvdb::math::MinMax<float> range = openvdb::tools::minMax(g.tree());
+      info.value_min = range.min();
+      info.value_max = range.max();
+    }
+    impl_->info = info;
+  });
+  return impl_->info;
 }
 
 float Volume::sample_index(const Vec3d& p_is) const {

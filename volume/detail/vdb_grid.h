@@ -2,12 +2,20 @@
 /// \file volume/-internal: the OpenVDB grid behind a Volume. Heavy header: include only from volume/*.cpp.
 #include <openvdb/openvdb.h>
 
+#include <mutex>
+
+#include "core/hash.h"
 #include "volume/volume.h"
 
 namespace raysift::volume {
 
 struct Volume::Impl {
+  /// Must not change once a Volume holds it: info() and content_hash() are computed once, on first use (a
+  /// Python Renderer or a camera path asks for them every frame, and each is a pass over the whole grid).
   openvdb::FloatGrid::Ptr grid;
+  mutable std::once_flag info_once, hash_once;
+  mutable GridInfo info;
+  mutable Hash128 content_hash{};
 };
 
 namespace detail {
