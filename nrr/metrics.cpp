@@ -61,13 +61,14 @@ struct MetricsContext {
   SamplingMode mode;
   Span<const DepthImage> reference, conventional;
   bool threaded, by_pixel;
+  Redundancy redundancy;
   std::vector<Camera> ref_cameras, conv_cameras;
   std::vector<detail::PixelProjector> ref_projectors, conv_projectors;
 
   MetricsContext(const SampledScene& s, SamplingMode m, Span<const DepthImage> ref, Span<const DepthImage> conv,
                  const MetricsOptions& options)
       : scene(s), mode(m), reference(ref), conventional(conv), threaded(options.threaded),
-        by_pixel(options.redundancy == Redundancy::Pixel) {
+        by_pixel(options.redundancy == Redundancy::Pixel), redundancy(options.redundancy) {
     for (const DepthImage& im : reference) ref_cameras.emplace_back(im.camera);
     for (const DepthImage& im : conventional) conv_cameras.emplace_back(im.camera);
     for (const Camera& camera : ref_cameras) ref_projectors.emplace_back(camera);
@@ -77,7 +78,8 @@ struct MetricsContext {
   /// Whether `image` (taken by `camera`) captured the surface point x of triangle id, by the redundancy rule.
   bool captured(const DepthImage& image, const Camera& camera, const detail::PixelProjector& projector, const Vec3f& x,
                 mesh::TriangleId id) const {
-    return by_pixel ? detail::pixel_captured(image, projector, x, id) : detail::visible_from(scene, camera, x, id);
+    return by_pixel ? detail::pixel_captured(image, projector, x, id)
+                    : detail::visibility_redundant(scene, camera, redundancy, x, id);
   }
 };
 
@@ -118,13 +120,16 @@ void classify_image(const MetricsContext& c, std::size_t i, ImageMetrics& image_
 
 /// Metric (4): whether the reference images hold the surface point x of triangle id.
 bool is_available(const MetricsContext& c, const Vec3f& x, mesh::TriangleId id) {
-  // Conventional and visibility-NRR images hold every point visible from one of their eyes (a point
-  // visible from V_j is in I_j or, being redundant, in an earlier image): a cheap occlusion ray settles
-  // most samples before the full rule is traced. For conventional images the rule adds nothing more.
-  const bool holds_all_visible = c.mode == SamplingMode::Conventional || c.mode == SamplingMode::NrrVisibility;
+  // Whether an image holds x is a fact about the image, so it always includes the image's frustum,
+  // whichever visibility definition the metrics use. Conventional and frustum-visibility NRR images
+  // hold every point visible inside one of their frusta (a point visible in I_j is in I_j or, being
+  // redundant, in an earlier image): a cheap occlusion ray settles most samples before the full rule
+  // is traced. Alg. 2 NRR images do not: a point seen from V_j outside I_j's frustum is in none.
+  const bool holds_all_visible =
+      c.mode == SamplingMode::Conventional || c.mode == SamplingMode::NrrVisibilityFrustum;
   if (!c.by_pixel && holds_all_visible) {
     for (const Camera& cam : c.ref_cameras)
-      if (detail::visible_from(c.scene, cam, x, id)) return true;
+      if (detail::visible_in_image(c.scene, cam, x, id)) return true;
     if (c.mode == SamplingMode::Conventional) return false;
   }
   for (std::size_t i = 0; i < c.reference.size(); ++i) {
@@ -133,7 +138,7 @@ bool is_available(const MetricsContext& c, const Vec3f& x, mesh::TriangleId id) 
       continue;
     }
     const Camera& cam = c.ref_cameras[i];
-    if (!detail::may_be_visible_from(c.scene, cam, x, id)) continue;
+    if (!detail::faces_eye(c.scene, cam.eye(), x, id) || !detail::in_frustum(cam, x)) continue;
     const Vec3f eye(cam.eye());
     const mesh::RayF ray{eye, x - eye};
     mesh::Hit hit;
@@ -184,14 +189,6 @@ void evaluate_intermediate_views(const MetricsContext& c, Span<const CameraSpec>
 }
 
 }  // namespace
-
-Redundancy parse_redundancy(const std::string& name) {
-  if (name == "pixel") return Redundancy::Pixel;
-  if (name == "visibility") return Redundancy::Visibility;
-  throw InvalidInput("redundancy must be one of: pixel, visibility; got '" + name + "'");
-}
-
-std::string to_string(Redundancy redundancy) { return redundancy == Redundancy::Pixel ? "pixel" : "visibility"; }
 
 SamplingMetrics compute_sampling_metrics(const SampledScene& scene, SamplingMode mode, Span<const CameraSpec> views,
                                          Span<const DepthImage> reference, Span<const DepthImage> conventional,

@@ -12,12 +12,6 @@
 
 namespace raysift::nrr {
 
-enum class Redundancy { Pixel, Visibility };
-
-/// "pixel" or "visibility". \throw InvalidInput otherwise.
-Redundancy parse_redundancy(const std::string& name);
-std::string to_string(Redundancy redundancy);
-
 /// Per-sample class, for the Fig. 6 style images.
 enum class SampleClass : std::uint8_t { Empty, Ordinary, Disoccluded, Useful };
 

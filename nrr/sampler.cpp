@@ -8,12 +8,27 @@
 
 namespace raysift::nrr {
 
+Redundancy parse_redundancy(const std::string& name) {
+  for (Redundancy r : {Redundancy::Pixel, Redundancy::Visibility, Redundancy::VisibilityFrustum})
+    if (name == to_string(r)) return r;
+  throw InvalidInput("redundancy must be one of: pixel, visibility, visibility-frustum; got '" + name + "'");
+}
+
+std::string to_string(Redundancy redundancy) {
+  switch (redundancy) {
+    case Redundancy::Pixel: return "pixel";
+    case Redundancy::Visibility: return "visibility";
+    case Redundancy::VisibilityFrustum: return "visibility-frustum";
+  }
+  return "?";
+}
+
 SamplingMode parse_sampling_mode(const std::string& name) {
-  if (name == "conventional") return SamplingMode::Conventional;
-  if (name == "nrr-pixel") return SamplingMode::NrrPixel;
-  if (name == "nrr-visibility") return SamplingMode::NrrVisibility;
-  if (name == "peel") return SamplingMode::Peel;
-  throw InvalidInput("sampling mode must be one of: conventional, nrr-pixel, nrr-visibility, peel; got '" + name + "'");
+  for (SamplingMode m : {SamplingMode::Conventional, SamplingMode::NrrPixel, SamplingMode::NrrVisibility,
+                         SamplingMode::NrrVisibilityFrustum, SamplingMode::Peel})
+    if (name == to_string(m)) return m;
+  throw InvalidInput("sampling mode must be one of: conventional, nrr-pixel, nrr-visibility, nrr-visibility-frustum, "
+                     "peel; got '" + name + "'");
 }
 
 std::string to_string(SamplingMode mode) {
@@ -21,9 +36,26 @@ std::string to_string(SamplingMode mode) {
     case SamplingMode::Conventional: return "conventional";
     case SamplingMode::NrrPixel: return "nrr-pixel";
     case SamplingMode::NrrVisibility: return "nrr-visibility";
+    case SamplingMode::NrrVisibilityFrustum: return "nrr-visibility-frustum";
     case SamplingMode::Peel: return "peel";
   }
   return "?";
+}
+
+SamplingMode nrr_mode(Redundancy redundancy) {
+  switch (redundancy) {
+    case Redundancy::Pixel: return SamplingMode::NrrPixel;
+    case Redundancy::Visibility: return SamplingMode::NrrVisibility;
+    case Redundancy::VisibilityFrustum: return SamplingMode::NrrVisibilityFrustum;
+  }
+  return SamplingMode::NrrPixel;
+}
+
+Redundancy redundancy_of(SamplingMode mode) {
+  RAYSIFT_CHECK(mode != SamplingMode::Conventional && mode != SamplingMode::Peel);
+  return mode == SamplingMode::NrrPixel        ? Redundancy::Pixel
+         : mode == SamplingMode::NrrVisibility ? Redundancy::Visibility
+                                               : Redundancy::VisibilityFrustum;
 }
 
 namespace {

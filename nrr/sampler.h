@@ -16,11 +16,29 @@
 
 namespace raysift::nrr {
 
-enum class SamplingMode { Conventional, NrrPixel, NrrVisibility, Peel };
+/// The redundancy definitions of Xie, Wang & Popescu 2016, by name. A sample x of triangle t is
+/// redundant with an earlier image I_j when:
+/// - Pixel (Alg. 3): x reprojects into I_j onto a pixel holding t;
+/// - Visibility (Alg. 2): the first surface hit from V_j toward x is x, nothing else (hits are
+///   front faces only, as every image culls back faces, so x's face must look at V_j);
+/// - VisibilityFrustum: Visibility and x lies inside I_j's frustum ([choice] ALGORITHMS.md §10).
+enum class Redundancy { Pixel, Visibility, VisibilityFrustum };
 
-/// "conventional", "nrr-pixel", "nrr-visibility", "peel". \throw InvalidInput for anything else.
+/// "pixel", "visibility", "visibility-frustum". \throw InvalidInput otherwise.
+Redundancy parse_redundancy(const std::string& name);
+std::string to_string(Redundancy redundancy);
+
+/// NrrVisibility is Alg. 2 exactly; NrrVisibilityFrustum adds the frustum test (see Redundancy).
+enum class SamplingMode { Conventional, NrrPixel, NrrVisibility, NrrVisibilityFrustum, Peel };
+
+/// "conventional", "nrr-pixel", "nrr-visibility", "nrr-visibility-frustum", "peel".
+/// \throw InvalidInput for anything else.
 SamplingMode parse_sampling_mode(const std::string& name);
 std::string to_string(SamplingMode mode);
+/// The NRR mode that renders with `redundancy`.
+SamplingMode nrr_mode(Redundancy redundancy);
+/// The redundancy an NRR mode renders with. \pre mode is one of the Nrr* modes.
+Redundancy redundancy_of(SamplingMode mode);
 
 /// A mesh prepared for sampling: its Embree scene, triangle normals and per-corner shading normals
 /// (area-weighted over the faces around the vertex within a 45 degree crease angle).

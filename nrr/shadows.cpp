@@ -53,7 +53,7 @@ std::vector<TriMesh> discretize_and_reconstruct(const SampledScene& scene, const
   SamplingOptions sampling;
   sampling.mode = method == ShadowMethod::Conventional ? SamplingMode::Conventional
                   : method == ShadowMethod::Peel       ? SamplingMode::Peel
-                                                       : options.nrr_redundancy;
+                                                       : nrr_mode(options.nrr_redundancy);
   sampling.peel_layers = 4;  // NRR §6.2: four layers from the light centre
   const bool hybrid = options.reconstruction_kind == ReconstructionKind::Hybrid ||
                       (options.reconstruction_kind == ReconstructionKind::Auto && method != ShadowMethod::Conventional);

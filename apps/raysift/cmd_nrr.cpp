@@ -1,16 +1,14 @@
-// raysift nrr: multi-view depth images of a mesh (conventional, non-redundant, depth peeling) and the
-// sampling-quality metrics of Xie, Wang & Popescu 2016 §6.1.2; maps the flags onto nrr/nrr_pipeline.h.
+// raysift nrr: multi-view depth images of a mesh (conventional, non-redundant, depth peeling), the
+// sampling-quality metrics of Xie, Wang & Popescu 2016 §6.1.2 and the redundancy masks of its Fig. 6;
+// maps the flags onto nrr/nrr_pipeline.h.
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <iostream>
 #include <map>
 #include <memory>
-#include <sstream>
 
 #include "apps/raysift/cli_checks.h"
 #include "apps/raysift/command.h"
-#include "core/output_set.h"
 #include "core/errors.h"
 #include "core/timer.h"
 #include "mesh/mesh_io.h"
@@ -20,8 +18,7 @@ namespace raysift::app {
 namespace {
 
 struct NrrCliOptions {
-  std::string mesh, out_dir, views_file, eyes;
-  std::string region;
+  std::string mesh, out_dir, mask_dir, views_file, eyes, region;
   std::vector<double> target, up{0, 1, 0};
   double fov_y_deg = 45.0;
   int resolution = 1024;
@@ -29,29 +26,12 @@ struct NrrCliOptions {
   nrr::NrrPipelineOptions lib;
 };
 
-const std::map<std::string, nrr::SamplingMode> kModes = {{"conventional", nrr::SamplingMode::Conventional},
-                                                         {"nrr-pixel", nrr::SamplingMode::NrrPixel},
-                                                         {"nrr-visibility", nrr::SamplingMode::NrrVisibility},
-                                                         {"peel", nrr::SamplingMode::Peel}};
-const std::map<std::string, nrr::Redundancy> kRedundancies = {{"pixel", nrr::Redundancy::Pixel},
-                                                              {"visibility", nrr::Redundancy::Visibility}};
-
-Vec3d vec3(const std::vector<double>& v) { return {v[0], v[1], v[2]}; }
-
-/// "x,y,z;x,y,z[;...]" -> eyes; exit 2 naming --eyes for a malformed entry.
-std::vector<Vec3d> parse_eyes(const std::string& text) {
-  std::vector<Vec3d> eyes;
-  std::stringstream items(text);
-  std::string item;
-  while (std::getline(items, item, ';')) {
-    std::istringstream in(item);
-    Vec3d v;
-    char c1 = 0, c2 = 0;
-    if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || !(in >> std::ws).eof() || !is_finite(v))
-      bad_flag("--eyes", "three finite numbers x,y,z per eye", "'" + item + "'");
-    eyes.push_back(v);
-  }
-  return eyes;
+/// name -> value for add_choice, the names being the library's own (to_string).
+template <typename E>
+std::map<std::string, E> by_name(std::initializer_list<E> values) {
+  std::map<std::string, E> names;
+  for (E v : values) names[nrr::to_string(v)] = v;
+  return names;
 }
 
 nrr::ViewSet views_from_options(const NrrCliOptions& o) {
@@ -64,28 +44,32 @@ nrr::ViewSet views_from_options(const NrrCliOptions& o) {
     const nrr::ViewRegion region = nrr::parse_view_region(o.region);  // checked by CLI11
     if (o.eyes.empty() || o.target.empty())
       throw UsageError("--view-region needs --eyes \"x,y,z;x,y,z...\" and --target x,y,z; see --help");
-    const std::vector<Vec3d> eyes = parse_eyes(o.eyes);
+    std::vector<Vec3d> eyes;
+    try {
+      eyes = nrr::parse_eye_list(o.eyes);
+    } catch (const InvalidInput& e) {
+      bad_flag("--eyes", "three finite numbers x,y,z per eye", e.what());
+    }
     if (int(eyes.size()) != nrr::corner_count(region))
       bad_flag("--eyes", std::to_string(nrr::corner_count(region)) + " eyes for a " + o.region,
                std::to_string(eyes.size()) + " eyes");
     CameraSpec common;
-    common.target = vec3(o.target);
-    common.up = vec3(o.up);
+    common.target = {o.target[0], o.target[1], o.target[2]};
+    common.up = {o.up[0], o.up[1], o.up[2]};
     common.fov_y_deg = o.fov_y_deg;
     set.views = nrr::region_views(region, Span<const Vec3d>(eyes), common);
   }
-  for (CameraSpec& v : set.views) v.width = v.height = o.resolution;
-  for (CameraSpec& v : set.intermediate) v.width = v.height = o.resolution;
+  for (std::vector<CameraSpec>* list : {&set.views, &set.intermediate})
+    for (CameraSpec& v : *list) v.width = v.height = o.resolution;
   return set;
-}
-
-Json image_json(const nrr::ImageMetrics& m) {
-  return {{"samples", m.samples}, {"redundant", m.redundant}, {"disoccluded", m.disoccluded}, {"useful", m.useful}};
 }
 
 void add_options(CLI::App& sub, NrrCliOptions& o) {
   sub.add_option("MESH", o.mesh, "input mesh .ply/.obj/.off")->required();
-  add_choice(sub, "--mode", o.lib.sampling.mode, kModes, "sampling method");
+  using M = nrr::SamplingMode;
+  add_choice(sub, "--mode", o.lib.sampling.mode,
+             by_name({M::Conventional, M::NrrPixel, M::NrrVisibility, M::NrrVisibilityFrustum, M::Peel}),
+             "sampling method (nrr-visibility: Alg. 2; -frustum: also inside the earlier image)");
   auto* views = sub.add_option_group("Views");
   views->add_option("--views", o.views_file,
                     "views JSON: a list of cameras, or {\"views\": [...], \"intermediate_views\": [...]}");
@@ -104,109 +88,57 @@ void add_options(CLI::App& sub, NrrCliOptions& o) {
   metrics->add_option("--intermediate-views", o.lib.intermediate_views,
                       "number of intermediate frames for metrics (3) and (4), spread over the eyes' region")
       ->check(CLI::PositiveNumber)->capture_default_str();
-  add_choice(*metrics, "--redundancy", o.lib.metrics.redundancy, kRedundancies, "redundancy used by the metrics");
+  using R = nrr::Redundancy;
+  add_choice(*metrics, "--redundancy", o.lib.metrics.redundancy,
+             by_name({R::Pixel, R::Visibility, R::VisibilityFrustum}),
+             "redundancy of the metrics: pixel (Alg. 3) | visibility (Alg. 2) | visibility-frustum");
   metrics->add_option("--layers", o.lib.sampling.peel_layers, "peel only: number of layers (0 = one per view)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   metrics->add_flag("--no-metrics", o.skip_metrics, "only render the images");
   sub.add_option("-o,--out", o.out_dir,
                  "output folder: image_<i>.exr (+ .png preview) and image_<i>_samples.png (Fig. 6 colours)");
+  sub.add_option("--mask-dir", o.mask_dir, "folder for mask_<i>.png: kept grey, redundant by pixel red, by "
+                                           "visibility only blue, background black (not with peel)");
   sub.footer(
       "Examples:\n"
       "  raysift make-scene blocks4 -o b4.ply && raysift nrr b4.ply --views b4.views.json --mode nrr-pixel -o out\n"
       "  raysift nrr grass.ply --view-region triangle --eyes \"-2.5,2.5,7;2.5,2.5,7;0,4.5,6\" --target 0,0.3,0 \\\n"
-      "      --mode peel --resolution 512 --intermediate-views 200 --stats s.json\n");
-}
-
-Json stats_json(const NrrCliOptions& o, const nrr::SampledScene& scene, const nrr::ViewSet& views,
-                const nrr::NrrPipelineResult& r, double load_ms) {
-  const nrr::SamplingMetrics& m = r.metrics;
-  Json stats = {{"mesh", o.mesh},
-                {"mode", nrr::to_string(o.lib.sampling.mode)},
-                {"redundancy", nrr::to_string(o.lib.metrics.redundancy)},
-                {"resolution", o.resolution},
-                {"views", views.views.size()},
-                {"triangles", scene.rays().triangle_count()},
-                {"degenerate_triangles", scene.rays().degenerate_triangle_count()},
-                {"triangle_pixel_ratio", r.triangle_pixel_ratio},
-                {"images", Json::array()}};
-  if (o.skip_metrics) {
-    for (const nrr::DepthImage& im : r.images) stats["images"].push_back({{"samples", im.sample_count()}});
-  } else {
-    stats["intermediate_views"] = r.intermediate_view_count;
-    for (const nrr::ImageMetrics& im : m.images) stats["images"].push_back(image_json(im));
-    stats["view_dependent"] = {{"available_avg_pct", m.available_avg_pct},
-                               {"available_min_pct", m.available_min_pct},
-                               {"frames_with_samples", m.frames_with_samples}};
-  }
-  stats["times_ms"] = {{"load", load_ms}, {"render", r.render_ms}, {"metrics", r.metrics_ms}};
-  return stats;
-}
-
-void print_summary(const NrrCliOptions& o, const nrr::NrrPipelineResult& r) {
-  std::printf("raysift nrr: %s, %zu images of %dx%d, render %.1f ms, metrics %.1f ms\n",
-              nrr::to_string(o.lib.sampling.mode).c_str(), r.images.size(), o.resolution, o.resolution, r.render_ms,
-              r.metrics_ms);
-  for (std::size_t i = 0; i < r.images.size(); ++i) {
-    if (o.skip_metrics) {
-      std::printf("  image %zu: %zu samples\n", i, r.images[i].sample_count());
-      continue;
-    }
-    const nrr::ImageMetrics& im = r.metrics.images[i];
-    std::printf("  image %zu: %zu samples, %zu redundant, %zu disoccluded (%zu useful)\n", i, im.samples, im.redundant,
-                im.disoccluded, im.useful);
-  }
-  if (!o.skip_metrics)
-    std::printf("  intermediate frames: available avg %.2f%%, min %.2f%% (%s redundancy)\n", r.metrics.available_avg_pct,
-                r.metrics.available_min_pct, nrr::to_string(o.lib.metrics.redundancy).c_str());
-}
-
-void write_images(const std::string& out_dir, const nrr::NrrPipelineResult& r, bool with_metrics) {
-  const std::filesystem::path dir(out_dir);
-  OutputSet outputs;  // every image or none, and no folder left behind by a failed run
-  outputs.make_directories(dir.string());
-  for (std::size_t i = 0; i < r.images.size(); ++i) {
-    const std::string stem = (dir / ("image_" + std::to_string(i))).string();
-    nrr::write_depth_image(r.images[i], outputs.stage(stem + ".exr"), outputs.stage(stem + ".png"));
-    if (with_metrics)
-      write_image(outputs.stage(stem + "_samples.png"),
-                  nrr::sample_class_image(r.images[i], r.metrics.sample_classes[i]));
-  }
-  outputs.commit();
+      "      --mode peel --resolution 512 --intermediate-views 200 --mask-dir masks --stats s.json\n");
 }
 
 RegisterCommand reg(
     "nrr", "sample a mesh with multi-view depth images (conventional, non-redundant, depth peeling) and measure them",
     [](CLI::App& sub, CommonOptions& common) -> RunFunction {
       auto opt = std::make_shared<NrrCliOptions>();
-      opt->lib.sampling.mode = nrr::SamplingMode::NrrPixel;
-      opt->lib.metrics.redundancy = nrr::Redundancy::Pixel;
       add_options(sub, *opt);
       return [opt, &common] {
         const NrrCliOptions& o = *opt;
-        if (!o.out_dir.empty() && std::filesystem::exists(o.out_dir) && !std::filesystem::is_directory(o.out_dir))
-          throw IoError(file_message(o.out_dir, "exists and is not a folder; -o takes an output folder"));
         const nrr::ViewSet views = views_from_options(o);
-        if (!o.skip_metrics && views.views.size() > 4 && views.intermediate.empty())
+        nrr::NrrPipelineOptions options = o.lib;
+        options.with_metrics = !o.skip_metrics;
+        options.with_masks = !o.mask_dir.empty();
+        if (options.with_masks && options.sampling.mode == nrr::SamplingMode::Peel)
+          throw UsageError("--mask-dir is for conventional and NRR modes, not peel; see --help");
+        if (options.with_metrics && views.views.size() > 4 && views.intermediate.empty())
           throw UsageError("metrics need 1-4 views (a point, segment, triangle or quadrilateral of eyes) or explicit "
                            "intermediate_views in the views file; got " + std::to_string(views.views.size()) +
                            " views; see --help (or pass --no-metrics)");
-        nrr::NrrPipelineOptions options = o.lib;
-        options.with_metrics = !o.skip_metrics;
-
         Timer load_timer;
-        const TriMesh mesh = mesh::read_mesh(o.mesh);
-        const nrr::SampledScene scene(mesh);
+        const nrr::SampledScene scene(mesh::read_mesh(o.mesh));
         const double load_ms = load_timer.elapsed_ms();
         const nrr::NrrPipelineResult r = nrr::run_nrr_pipeline(scene, views, options);
         for (std::size_t i = 0; i < r.images.size(); ++i)
           if (r.images[i].sample_count() == 0 && !common.quiet)
             std::cerr << "raysift nrr: warning: image " << i << " holds no sample (does the view look away from "
                       << "the scene?)\n";
-        if (!o.out_dir.empty()) write_images(o.out_dir, r, options.with_metrics);
-        if (!common.quiet) print_summary(o, r);
+        nrr::write_nrr_outputs(r, o.out_dir, o.mask_dir);
+        if (!common.quiet) std::fputs(nrr::nrr_summary(options, r).c_str(), stdout);
         if (common.verbose)
           std::printf("  times: load %.1f ms, render %.1f ms, metrics %.1f ms\n", load_ms, r.render_ms, r.metrics_ms);
-        write_stats_if_requested(common, stats_json(o, scene, views, r, load_ms));
+        Json stats = nrr::nrr_stats_json(scene, views, options, r);
+        stats["mesh"] = o.mesh;
+        stats["times_ms"]["load"] = load_ms;
+        write_stats_if_requested(common, stats);
       };
     },
     false);

@@ -45,8 +45,10 @@ const std::map<std::string, nrr::ReconstructionKind> kReconstructions = {
     {"auto", nrr::ReconstructionKind::Auto},
     {"conventional", nrr::ReconstructionKind::Conventional},
     {"hybrid", nrr::ReconstructionKind::Hybrid}};
-const std::map<std::string, nrr::SamplingMode> kRedundancies = {{"visibility", nrr::SamplingMode::NrrVisibility},
-                                                                {"pixel", nrr::SamplingMode::NrrPixel}};
+const std::map<std::string, nrr::Redundancy> kRedundancies = {
+    {"pixel", nrr::Redundancy::Pixel},
+    {"visibility", nrr::Redundancy::Visibility},
+    {"visibility-frustum", nrr::Redundancy::VisibilityFrustum}};
 
 Json errors_json(const nrr::ShadowErrors& e) {
   return Json{{"visibility_error_avg", e.visibility_error_avg}, {"visibility_error_max", e.visibility_error_max},
@@ -76,7 +78,7 @@ void add_options(CLI::App& sub, ShadowsOptions& o) {
   add_choice(*method, "--fit", s.fit, kFits, "shadow-map frustum encloses: scene (bounding box) | receivers");
   add_choice(*method, "--reconstruction", s.reconstruction_kind, kReconstructions,
              "auto (2x2 for conventional, hybrid for nrr/peel) | conventional | hybrid");
-  add_choice(*method, "--redundancy", s.nrr_redundancy, kRedundancies, "nrr redundancy test: visibility | pixel");
+  add_choice(*method, "--redundancy", s.nrr_redundancy, kRedundancies, "nrr redundancy test: pixel (Alg. 3) | visibility (Alg. 2) | visibility-frustum");
   method->add_option("--threshold", s.reconstruction.discontinuity_rel, "depth-discontinuity threshold, fraction of depth")
       ->capture_default_str();
   method->add_option("--corner-clamp", s.reconstruction.corner_clamp_rel,
@@ -147,6 +149,7 @@ void print_and_write(const ShadowsOptions& o, const CommonOptions& common, const
   Json stats = errors_json(run.errors);
   stats["method"] = method;
   stats["reference"] = reference;
+  if (o.lib.method == nrr::ShadowMethod::Nrr) stats["redundancy"] = nrr::to_string(s.nrr_redundancy);
   stats["counted_pixels"] = run.errors.counted_pixels;
   stats["light"] = light;
   stats["light_samples"] = s.light_samples_per_side * s.light_samples_per_side;

@@ -71,20 +71,33 @@ bool pixel_captured(const DepthImage& image, const PixelProjector& projector, co
   return pixel >= 0 && image.triangle_id[std::size_t(pixel)] == id;
 }
 
-bool may_be_visible_from(const SampledScene& scene, const Camera& camera, const Vec3f& x, mesh::TriangleId id) {
-  const Vec3d to_x = Vec3d(x) - camera.eye();
-  if (!(dot(scene.face_normal(id), to_x) < 0.0)) return false;
+bool in_frustum(const Camera& camera, const Vec3f& x) {
   const auto p = camera.project(Vec3d(x));
   return p && p->x_ss >= 0.0 && p->x_ss < camera.width() && p->y_ss >= 0.0 && p->y_ss < camera.height();
 }
 
-bool visible_from(const SampledScene& scene, const Camera& camera, const Vec3f& x, mesh::TriangleId id) {
-  if (!may_be_visible_from(scene, camera, x, id)) return false;
-  const Vec3f eye(camera.eye());
-  // Back faces do not occlude: the image from `camera` culls them, so they cannot hide x in it.
+bool faces_eye(const SampledScene& scene, const Vec3d& eye, const Vec3f& x, mesh::TriangleId id) {
+  return dot(scene.face_normal(id), Vec3d(x) - eye) < 0.0;
+}
+
+bool line_of_sight(const SampledScene& scene, const Vec3d& eye_d, const Vec3f& x, mesh::TriangleId id) {
+  if (!faces_eye(scene, eye_d, x, id)) return false;
+  const Vec3f eye(eye_d);
   mesh::QueryOptions cull;
   cull.cull_back_faces = true;
   return !scene.rays().occluded({eye, x - eye, 0.0f, 1.0f - float(tol::kSegmentEndRelative)}, cull);
+}
+
+bool may_be_visibility_redundant(const SampledScene& scene, const Camera& camera, Redundancy redundancy,
+                                 const Vec3f& x, mesh::TriangleId id) {
+  RAYSIFT_CHECK(redundancy != Redundancy::Pixel);
+  return faces_eye(scene, camera.eye(), x, id) &&
+         (redundancy == Redundancy::Visibility || in_frustum(camera, x));
+}
+
+bool visibility_redundant(const SampledScene& scene, const Camera& camera, Redundancy redundancy, const Vec3f& x,
+                          mesh::TriangleId id) {
+  return may_be_visibility_redundant(scene, camera, redundancy, x, id) && line_of_sight(scene, camera.eye(), x, id);
 }
 
 void trace(const SampledScene& scene, const ImageRule& rule, Span<const mesh::RayF> rays, Span<mesh::Hit> hits,
@@ -114,19 +127,21 @@ void trace(const SampledScene& scene, const ImageRule& rule, Span<const mesh::Ra
       scene.rays().intersect(rays, hits, options);
       return;
     }
-    case SamplingMode::NrrVisibility: {
+    case SamplingMode::NrrVisibility:
+    case SamplingMode::NrrVisibilityFrustum: {
       if (rule.previous_cameras.empty()) {
         scene.rays().intersect(rays, hits, options);
         return;
       }
-      // A candidate outside every earlier frustum, or facing away from every earlier eye, is surely
-      // non-redundant and is accepted at once (pruning the traversal); the others are collected and
-      // tested with occlusion rays after the traversal, nearest first.
+      // A candidate facing away from every earlier eye (or, with the frustum variant, outside every
+      // earlier frustum) is surely non-redundant and is accepted at once (pruning the traversal); the
+      // others are collected and tested with occlusion rays after the traversal, nearest first.
+      const Redundancy redundancy = redundancy_of(rule.mode);
       std::vector<std::vector<Candidate>> maybe(rays.size());
       const mesh::HitFilter collect = [&](const mesh::HitCandidate& c) {
         const Vec3f x = sample_position(rays[c.ray_index], c.t);
         for (const Camera& cam : rule.previous_cameras)
-          if (may_be_visible_from(scene, cam, x, c.triangle_id)) {
+          if (may_be_visibility_redundant(scene, cam, redundancy, x, c.triangle_id)) {
             maybe[c.ray_index].push_back(to_candidate(c));
             return false;
           }
@@ -144,7 +159,9 @@ void trace(const SampledScene& scene, const ImageRule& rule, Span<const mesh::Ra
           if (!(c.t < hits[i].t)) break;
           const Vec3f x = sample_position(rays[i], c.t);
           const bool is_redundant = std::any_of(rule.previous_cameras.begin(), rule.previous_cameras.end(),
-                                                [&](const Camera& cam) { return visible_from(scene, cam, x, c.id); });
+                                                [&](const Camera& cam) {
+                                                  return visibility_redundant(scene, cam, redundancy, x, c.id);
+                                                });
           if (!is_redundant) {
             hits[i] = to_hit(scene, c);
             break;

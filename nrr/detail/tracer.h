@@ -42,17 +42,31 @@ inline bool pixel_captured(const DepthImage& image, const Camera& camera, const 
   return pixel_captured(image, PixelProjector(camera), x, id);
 }
 
-/// Visibility (Alg. 2, plus the frustum [choice] of ALGORITHMS.md §10): `x` on triangle `id` lies in
-/// the camera's image, its face looks at the eye, and the segment eye -> x is unoccluded by front faces.
-bool visible_from(const SampledScene& scene, const Camera& camera, const Vec3f& x, mesh::TriangleId id);
-/// The cheap part of visible_from (frustum and facing), usable inside a filter.
-bool may_be_visible_from(const SampledScene& scene, const Camera& camera, const Vec3f& x, mesh::TriangleId id);
+/// x projects inside the camera's image (in front of the eye, within [0, w) x [0, h)).
+bool in_frustum(const Camera& camera, const Vec3f& x);
+/// x's face (triangle id) looks at `eye`: the culled images can only hold x from such an eye.
+bool faces_eye(const SampledScene& scene, const Vec3d& eye, const Vec3f& x, mesh::TriangleId id);
+/// Alg. 2: x is the first front face hit from `eye` toward x (it faces the eye and no front face
+/// occludes the segment; back faces do not occlude because every image culls them).
+bool line_of_sight(const SampledScene& scene, const Vec3d& eye, const Vec3f& x, mesh::TriangleId id);
+/// Visibility redundancy of x with the image of `camera`: line_of_sight, and for VisibilityFrustum
+/// also in_frustum. \pre redundancy is Visibility or VisibilityFrustum.
+bool visibility_redundant(const SampledScene& scene, const Camera& camera, Redundancy redundancy, const Vec3f& x,
+                          mesh::TriangleId id);
+/// The cheap part of visibility_redundant (facing and, for VisibilityFrustum, the frustum): false
+/// means surely not redundant. Usable inside a filter.
+bool may_be_visibility_redundant(const SampledScene& scene, const Camera& camera, Redundancy redundancy,
+                                 const Vec3f& x, mesh::TriangleId id);
+/// Whether a conventional image from `camera` holds x: in its frustum and in line of sight.
+inline bool visible_in_image(const SampledScene& scene, const Camera& camera, const Vec3f& x, mesh::TriangleId id) {
+  return visibility_redundant(scene, camera, Redundancy::VisibilityFrustum, x, id);
+}
 
 /// How one image picks its sample along a ray.
 struct ImageRule {
   SamplingMode mode = SamplingMode::Conventional;
   Span<const DepthImage> previous;  ///< nrr-pixel: the images before this one
-  Span<const Camera> previous_cameras;  ///< nrr-pixel and nrr-visibility: their cameras
+  Span<const Camera> previous_cameras;  ///< the NRR modes: their cameras
   int layer = 0;                    ///< peel: 0 = nearest front face
 };
 

@@ -166,14 +166,16 @@ TEST(Metrics, DefinitionalZeros) {
 }
 
 /// Fraction of samples that are disoccluded, with NRR by pixel redundancy measured by pixel
-/// redundancy and NRR by visibility measured by visibility.
+/// redundancy and NRR by visibility measured by visibility. The frustum variant: these strips' frusta
+/// cut the scene, and pixel redundancy (a reprojection) can only converge to visibility inside them.
 double disoccluded_gap(const SampledScene& scene, const std::vector<CameraSpec>& views) {
   const std::vector<CameraSpec> frame = {views[0]};
   const auto conv = render(scene, views, SamplingMode::Conventional);
   const auto pix = render(scene, views, SamplingMode::NrrPixel);
-  const auto vis = render(scene, views, SamplingMode::NrrVisibility);
+  const auto vis = render(scene, views, SamplingMode::NrrVisibilityFrustum);
   const SamplingMetrics mp = metrics(scene, SamplingMode::NrrPixel, views, pix, conv, frame, Redundancy::Pixel);
-  const SamplingMetrics mv = metrics(scene, SamplingMode::NrrVisibility, views, vis, conv, frame, Redundancy::Visibility);
+  const SamplingMetrics mv = metrics(scene, SamplingMode::NrrVisibilityFrustum, views, vis, conv, frame,
+                                     Redundancy::VisibilityFrustum);
   return std::abs(double(mp.images[1].disoccluded) - double(mv.images[1].disoccluded)) / double(mv.images[1].samples);
 }
 

@@ -83,10 +83,55 @@ TEST(NrrPipeline, MetricsMatchTheStagesAndBadViewSetsThrow) {
   EXPECT_THROW(run_nrr_pipeline(b.sampled, ViewSet{}, o), InvalidInput);
   o.with_metrics = true;
   ViewSet five = views;
-  while (five.views.size() < 5) five.views.push_back(views.views[0]);
+  while (five.views.size() < 5) {
+    five.views.push_back(views.views[0]);
+    five.views.back().eye.x += double(five.views.size());  // distinct eyes: only the count is wrong
+  }
   EXPECT_THROW(run_nrr_pipeline(b.sampled, five, o), InvalidInput);  // metrics need 1-4 eyes or explicit frames
   o.intermediate_views = 0;
   EXPECT_THROW(run_nrr_pipeline(b.sampled, views, o), InvalidInput);
+}
+
+TEST(NrrPipeline, CoincidentEyesAreRejectedNamingTheViews) {
+  const Blocks b;
+  ViewSet views = b.g.views;
+  views.views.at(1).eye = views.views.at(0).eye;
+  views.views[1].target.x += 1.0;  // a different direction does not make a different viewpoint
+  try {
+    run_nrr_pipeline(b.sampled, views, {});
+    FAIL() << "coincident eyes accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("views 0 and 1"), std::string::npos) << e.what();
+  }
+}
+
+TEST(NrrPipeline, PixelMaskMarksExactlyTheSamplesPixelNrrRemoved) {
+  SceneOptions so;
+  so.seed = 5;
+  so.triangles = 3002;
+  const GeneratedScene g = make_scene(SceneKind::Grass, so);
+  const SampledScene scene(g.mesh);
+  ViewSet views = g.views;
+  for (CameraSpec& v : views.views) v.width = v.height = 80;
+  NrrPipelineOptions o;
+  o.with_metrics = false;
+  o.with_masks = true;
+  const NrrPipelineResult r = run_nrr_pipeline(scene, views, o);
+  const auto conv = render_depth_images(scene, Span<const CameraSpec>(views.views), {SamplingMode::Conventional});
+  std::size_t by_pixel = 0, by_visibility = 0;
+  for (std::size_t i = 0; i < conv.size(); ++i)
+    for (std::size_t p = 0; p < conv[i].pixel_count(); ++p) {
+      const MaskClass c = r.masks[i].classes[p];
+      ASSERT_EQ(c == MaskClass::Background, !conv[i].has_sample(p));
+      const bool removed = conv[i].has_sample(p) && r.images[i].triangle_id[p] != conv[i].triangle_id[p];
+      ASSERT_EQ(c == MaskClass::RedundantByPixel, removed) << "image " << i << " pixel " << p;
+      by_pixel += c == MaskClass::RedundantByPixel ? 1 : 0;
+      by_visibility += c == MaskClass::RedundantByVisibility ? 1 : 0;
+    }
+  EXPECT_GT(by_pixel, 500u);
+  EXPECT_GT(by_visibility, 50u);  // Alg. 3 misses some (sub-pixel blades, edges): NRR Fig. 7
+  o.sampling.mode = SamplingMode::Peel;
+  EXPECT_THROW(run_nrr_pipeline(scene, views, o), InvalidInput);
 }
 
 }  // namespace

@@ -77,7 +77,8 @@ TEST_P(NrrModes, NoSampleIsRedundantWithAnEarlierImage) {
         if (GetParam() == SamplingMode::NrrPixel)
           ASSERT_FALSE(detail::pixel_captured(images[j], cams[j], x, id)) << "image " << i << " pixel " << p;
         else
-          ASSERT_FALSE(detail::visible_from(scene, cams[j], x, id)) << "image " << i << " pixel " << p;
+          ASSERT_FALSE(detail::visibility_redundant(scene, cams[j], redundancy_of(GetParam()), x, id))
+              << "image " << i << " pixel " << p;
       }
     }
   EXPECT_GT(checked, 1000u);  // the later images do hold samples
@@ -97,8 +98,9 @@ TEST_P(NrrModes, ConventionalImage1IsRedundantExactlyWhereNrrDiffers) {
     }
     const Vec3f& x = conv[1].position_ws[p];
     const auto id = conv[1].triangle_id[p];
-    const bool is_redundant = GetParam() == SamplingMode::NrrPixel ? detail::pixel_captured(conv[0], cam0, x, id)
-                                                                   : detail::visible_from(scene, cam0, x, id);
+    const bool is_redundant = GetParam() == SamplingMode::NrrPixel
+                                  ? detail::pixel_captured(conv[0], cam0, x, id)
+                                  : detail::visibility_redundant(scene, cam0, redundancy_of(GetParam()), x, id);
     const bool differs = nrr[1].triangle_id[p] != id;
     differing += differs ? 1 : 0;
     ASSERT_EQ(is_redundant, differs) << "pixel " << p;
@@ -117,8 +119,14 @@ TEST_P(NrrModes, BackFacesAreNeverSampled) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Sampler, NrrModes,
-                         ::testing::Values(SamplingMode::NrrPixel, SamplingMode::NrrVisibility),
-                         [](const auto& info) { return info.param == SamplingMode::NrrPixel ? "Pixel" : "Visibility"; });
+                         ::testing::Values(SamplingMode::NrrPixel, SamplingMode::NrrVisibility,
+                                           SamplingMode::NrrVisibilityFrustum),
+                         [](const auto& info) {
+                           const Redundancy r = redundancy_of(info.param);
+                           return r == Redundancy::Pixel        ? "Pixel"
+                                  : r == Redundancy::Visibility ? "Visibility"
+                                                                : "VisibilityFrustum";
+                         });
 
 TEST(Sampler, ConvexMeshLaterImagesHoldOnlyWhatEarlierEyesCannotSee) {
   const TriMesh sphere = mesh::make_icosphere(1.0, 2);
@@ -127,7 +135,7 @@ TEST(Sampler, ConvexMeshLaterImagesHoldOnlyWhatEarlierEyesCannotSee) {
   const std::vector<CameraSpec> views = {camera({0, 0, 4}, {}, 60, 128), camera({3, 0, 2}, {}, 60, 128),
                                          camera({0, 3.5, -1}, {}, 60, 128)};
   const auto conv = render(scene, views, SamplingMode::Conventional);
-  for (SamplingMode mode : {SamplingMode::NrrPixel, SamplingMode::NrrVisibility}) {
+  for (SamplingMode mode : {SamplingMode::NrrPixel, SamplingMode::NrrVisibility, SamplingMode::NrrVisibilityFrustum}) {
     const auto nrr = render(scene, views, mode);
     std::size_t seen_earlier = 0, rejected = 0;
     for (std::size_t i = 1; i < views.size(); ++i)
@@ -148,7 +156,7 @@ TEST(Sampler, ConvexMeshLaterImagesHoldOnlyWhatEarlierEyesCannotSee) {
         ++seen_earlier;
         rejected += nrr[i].has_sample(p) ? 0 : 1;
       }
-    if (mode == SamplingMode::NrrVisibility) {
+    if (mode != SamplingMode::NrrPixel) {
       EXPECT_EQ(rejected, seen_earlier);
     } else {
       // Pixel redundancy misses a sample only where its reprojection lands on another triangle: near
@@ -199,7 +207,8 @@ TEST(Sampler, CoincidentEyesGiveTheSecondPeelingLayer) {
 TEST(Sampler, ResultsDoNotDependOnThreadCount) {
   const SampledScene scene(small_grass().mesh);
   const auto views = sized(small_grass().views.views, 64);
-  for (SamplingMode mode : {SamplingMode::NrrPixel, SamplingMode::NrrVisibility, SamplingMode::Peel}) {
+  for (SamplingMode mode : {SamplingMode::NrrPixel, SamplingMode::NrrVisibility, SamplingMode::NrrVisibilityFrustum,
+                            SamplingMode::Peel}) {
     SamplingOptions serial;
     serial.mode = mode;
     serial.threaded = false;
