@@ -194,7 +194,7 @@ double bare_embree_ms(const TriMesh& m, const CameraSpec& spec, int repeats, std
 
 /// The NRR variants timed against conventional images, in the library's names.
 const nrr::SamplingMode kTimedModes[] = {nrr::SamplingMode::Conventional, nrr::SamplingMode::NrrPixel,
-                                         nrr::SamplingMode::NrrVisibility};
+                                         nrr::SamplingMode::NrrVisibility, nrr::SamplingMode::NrrVisibilityFrustum};
 
 /// RayScene alone: culled closest hits over view 0's camera rays in 4x4 blocks, nothing stored.
 double trace_only_ms(const nrr::SampledScene& scene, const CameraSpec& view, int repeats) {
