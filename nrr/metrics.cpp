@@ -94,7 +94,7 @@ void classify_image(const MetricsContext& c, std::size_t i, ImageMetrics& image_
   image_metrics.redundant = count_if_index(im.pixel_count(), c.threaded, [&](std::size_t p) {
     if (!im.has_sample(p)) return false;
     for (std::size_t j = 0; j < i; ++j)
-      if (c.captured(c.reference[j], c.ref_cameras[j], c.ref_projectors[j], im.position_ws[p], im.triangle_id[p]))
+      if (c.captured(c.reference[j], c.ref_cameras[j], c.ref_projectors[j], im.position_ws(p), im.triangle_id[p]))
         return true;
     return false;
   });
@@ -109,7 +109,7 @@ void classify_image(const MetricsContext& c, std::size_t i, ImageMetrics& image_
       // directly (also right for hits at t = 0, which cannot be projected).
       const bool is_same_view = c.by_pixel && j == i && c.mode != SamplingMode::Peel;
       if (is_same_view ? c.conventional[j].triangle_id[p] == im.triangle_id[p]
-                       : c.captured(c.conventional[j], c.conv_cameras[j], c.conv_projectors[j], im.position_ws[p],
+                       : c.captured(c.conventional[j], c.conv_cameras[j], c.conv_projectors[j], im.position_ws(p),
                                     im.triangle_id[p]))
         return false;
     }
@@ -167,7 +167,7 @@ void evaluate_intermediate_views(const MetricsContext& c, Span<const CameraSpec>
     const std::size_t samples = frame.sample_count();
     if (samples > 0) {
       const std::size_t available = count_if_index(frame.pixel_count(), c.threaded, [&](std::size_t p) {
-        return frame.has_sample(p) && is_available(c, frame.position_ws[p], frame.triangle_id[p]);
+        return frame.has_sample(p) && is_available(c, frame.position_ws(p), frame.triangle_id[p]);
       });
       const double pct = 100.0 * double(available) / double(samples);
       pct_sum += pct;
@@ -178,7 +178,7 @@ void evaluate_intermediate_views(const MetricsContext& c, Span<const CameraSpec>
     count_if_index(disoccluded.size(), c.threaded, [&](std::size_t k) {
       const auto [i, p] = disoccluded[k];
       if (m.sample_classes[i][p] == SampleClass::Useful) return false;
-      if (!c.captured(frame, frame_camera, frame_projector, c.reference[i].position_ws[p],
+      if (!c.captured(frame, frame_camera, frame_projector, c.reference[i].position_ws(p),
                       c.reference[i].triangle_id[p]))
         return false;
       m.sample_classes[i][p] = SampleClass::Useful;
@@ -208,6 +208,7 @@ SamplingMetrics compute_sampling_metrics(const SampledScene& scene, SamplingMode
 
 ImageRGBA sample_class_image(const DepthImage& image, const std::vector<SampleClass>& classes) {
   RAYSIFT_CHECK_OP(classes.size(), ==, image.pixel_count());
+  RAYSIFT_CHECK_OP(image.normal_ws.size(), ==, image.pixel_count());
   ImageRGBA out(image.width, image.height, Rgba{0, 0, 0, 1});
   const Vec3d view = normalize(image.camera.target - image.camera.eye);
   for (std::size_t p = 0; p < classes.size(); ++p) {

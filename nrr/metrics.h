@@ -49,7 +49,7 @@ SamplingMetrics compute_sampling_metrics(const SampledScene& scene, SamplingMode
                                          Span<const CameraSpec> intermediate, const MetricsOptions& options = {});
 
 /// Fig. 6 colouring: useful samples yellow, other disoccluded samples green, ordinary samples grey
-/// shaded by their normal's facing, empty pixels black.
+/// shaded by their normal's facing, empty pixels black. \pre image.normal_ws is filled (fill_normals).
 ImageRGBA sample_class_image(const DepthImage& image, const std::vector<SampleClass>& classes);
 
 }  // namespace raysift::nrr

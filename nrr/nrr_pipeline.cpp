@@ -81,7 +81,8 @@ NrrPipelineResult run_nrr_pipeline(const SampledScene& scene, const ViewSet& vie
   return out;
 }
 
-void write_nrr_outputs(const NrrPipelineResult& r, const std::string& out_dir, const std::string& mask_dir) {
+void write_nrr_outputs(const SampledScene& scene, const NrrPipelineResult& r, const std::string& out_dir,
+                       const std::string& mask_dir) {
   OutputSet outputs;  // every file or none, and no folder left behind by a failed run
   for (const std::string& dir : {out_dir, mask_dir})
     if (!dir.empty() && std::filesystem::exists(dir) && !std::filesystem::is_directory(dir))
@@ -90,9 +91,11 @@ void write_nrr_outputs(const NrrPipelineResult& r, const std::string& out_dir, c
     outputs.make_directories(out_dir);
     for (std::size_t i = 0; i < r.images.size(); ++i) {
       const std::string stem = (std::filesystem::path(out_dir) / ("image_" + std::to_string(i))).string();
-      write_depth_image(r.images[i], outputs.stage(stem + ".exr"), outputs.stage(stem + ".png"));
+      DepthImage image = r.images[i];
+      fill_normals(scene, image, NormalKind::Shading);
+      write_depth_image(image, outputs.stage(stem + ".exr"), outputs.stage(stem + ".png"));
       if (!r.metrics.sample_classes.empty())
-        write_image(outputs.stage(stem + "_samples.png"), sample_class_image(r.images[i], r.metrics.sample_classes[i]));
+        write_image(outputs.stage(stem + "_samples.png"), sample_class_image(image, r.metrics.sample_classes[i]));
     }
   }
   if (!mask_dir.empty()) {

@@ -47,10 +47,11 @@ Redundancy mask_visibility(const NrrPipelineOptions& options);
 ///        views, or masks with peel; as render_depth_images and compute_sampling_metrics.
 NrrPipelineResult run_nrr_pipeline(const SampledScene& scene, const ViewSet& views, const NrrPipelineOptions& options = {});
 
-/// Writes, all or nothing, image_<i>.exr and .png (plus image_<i>_samples.png with metrics) into
-/// `out_dir` and mask_<i>.png into `mask_dir`; an empty folder name skips that part.
+/// Writes, all or nothing, image_<i>.exr and .png (shading normals; plus image_<i>_samples.png with
+/// metrics) into `out_dir` and mask_<i>.png into `mask_dir`; an empty folder name skips that part.
 /// \throw IoError naming the file or folder.
-void write_nrr_outputs(const NrrPipelineResult& result, const std::string& out_dir, const std::string& mask_dir);
+void write_nrr_outputs(const SampledScene& scene, const NrrPipelineResult& result, const std::string& out_dir,
+                       const std::string& mask_dir);
 
 /// The human-readable summary: mode, size, times, per-image counts and availability.
 std::string nrr_summary(const NrrPipelineOptions& options, const NrrPipelineResult& result);

@@ -44,7 +44,7 @@ std::vector<RedundancyMask> redundancy_masks(const SampledScene& scene, Span<con
     mask.classes.assign(conv.pixel_count(), MaskClass::Background);
     parallel_for_each(conv.pixel_count(), [&](std::size_t p) {
       if (!conv.has_sample(p)) return;
-      const Vec3f x = conv.position_ws[p];
+      const Vec3f x = conv.position_ws(p);
       const mesh::TriangleId id = conv.triangle_id[p];
       MaskClass c = MaskClass::Kept;
       for (std::size_t j = 0; j < i && c != MaskClass::RedundantByPixel; ++j)

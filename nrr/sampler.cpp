@@ -67,7 +67,7 @@ constexpr double kCreaseAngleDeg = 45.0;
 constexpr double kFlatCosine = 1.0 - 1e-6;
 }  // namespace
 
-SampledScene::SampledScene(const TriMesh& mesh) : rays_(mesh) {
+SampledScene::SampledScene(const TriMesh& mesh) : rays_(mesh), mesh_(mesh) {
   const std::size_t n_tris = mesh.triangle_count();
   face_normals_.reserve(n_tris);
   std::vector<Vec3d> area_normals;
@@ -105,6 +105,48 @@ Vec3f SampledScene::shading_normal(mesh::TriangleId id, float u, float v, const 
   return dot(n, face_normal) > 0.0f ? n : face_normal;
 }
 
+namespace {
+/// The geometric normal Embree reports for a ray from `origin` (mesh::Hit::normal_ws): its robust
+/// (Pluecker) intersector's stable_triangle_normal of the origin-relative edges, normalised in float.
+/// Reproduced so that derived normals equal the stored ones of the full record, signed zeros included.
+Vec3f embree_normal(const Vec3f& p0, const Vec3f& p1, const Vec3f& p2, const Vec3f& origin) {
+  const Vec3f v0 = p0 - origin, v1 = p1 - origin, v2 = p2 - origin;
+  const Vec3f a = v2 - v0, b = v0 - v1, c = v1 - v2;
+  const auto pick = [](float a1, float a2, float ab, float b1, float b2, float bc) {
+    return std::abs(ab) < std::abs(bc) ? std::fma(a1, a2, -ab) : std::fma(b1, b2, -bc);
+  };
+  const Vec3f n{pick(a.y, b.z, a.z * b.y, b.y, c.z, b.z * c.y), pick(a.z, b.x, a.x * b.z, b.z, c.x, b.x * c.z),
+                pick(a.x, b.y, a.y * b.x, b.x, c.y, b.y * c.x)};
+  return normalize(n);
+}
+}  // namespace
+
+Vec3f SampledScene::shading_normal_at(mesh::TriangleId id, const Vec3f& x, const Vec3f& origin) const {
+  const std::uint32_t t = mesh::triangle_id_index(id);
+  const auto& tri = mesh_.triangles[t];
+  const Vec3f& v0 = mesh_.positions[tri[0]];
+  const Vec3f face = embree_normal(v0, mesh_.positions[tri[1]], mesh_.positions[tri[2]], origin);
+  if (is_flat_[t]) return face;
+  // Barycentrics of x by the least-squares projection onto the triangle's plane (x lies on it up to
+  // the rounding of the sample point), in double.
+  const Vec3d p0(v0), e1 = Vec3d(mesh_.positions[tri[1]]) - p0, e2 = Vec3d(mesh_.positions[tri[2]]) - p0,
+               d = Vec3d(x) - p0;
+  const double a = dot(e1, e1), b = dot(e1, e2), c = dot(e2, e2), f = dot(d, e1), g = dot(d, e2);
+  const double det = a * c - b * b;
+  if (!(det > 0.0)) return face;
+  return shading_normal(id, float((c * f - b * g) / det), float((a * g - b * f) / det), face);
+}
+
+void fill_normals(const SampledScene& scene, DepthImage& image, NormalKind kind) {
+  image.normal_ws.assign(image.pixel_count(), Vec3f{});
+  for (std::size_t p = 0; p < image.pixel_count(); ++p) {
+    if (!image.has_sample(p)) continue;
+    const mesh::TriangleId id = image.triangle_id[p];
+    image.normal_ws[p] = kind == NormalKind::Face ? Vec3f(scene.face_normal(id))
+                                                  : scene.shading_normal_at(id, image.position_ws(p), image.rays.origin());
+  }
+}
+
 CameraSpec peel_camera(Span<const CameraSpec> views) {
   if (views.empty()) throw InvalidInput("depth peeling needs at least one view");
   CameraSpec c = views[0];
@@ -125,15 +167,13 @@ std::vector<DepthImage> render_depth_images(const SampledScene& scene, Span<cons
     throw InvalidInput("peel_layers must be >= 0 (0 = one layer per view), got " + std::to_string(options.peel_layers));
   std::vector<DepthImage> images;
   if (options.mode == SamplingMode::Peel) {
-    const Camera camera(peel_camera(views));
     const int k = options.peel_layers > 0 ? options.peel_layers : int(views.size());
-    images.assign(std::size_t(k), DepthImage(camera.spec()));
-    detail::for_each_tile(camera, options.threaded, [&](Span<const mesh::RayF> rays, Span<const std::size_t> pixels) {
+    images.assign(std::size_t(k), DepthImage(peel_camera(views)));
+    detail::for_each_tile(images[0], options.threaded, [&](Span<const mesh::RayF> rays, Span<const std::size_t> pixels) {
       std::vector<mesh::Hit> layers(rays.size() * std::size_t(k));
       detail::trace_layers(scene, k, rays, Span<mesh::Hit>(layers), true);
       for (std::size_t l = 0; l < std::size_t(k); ++l)
-        for (std::size_t i = 0; i < rays.size(); ++i)
-          detail::store_sample(scene, rays[i], layers[l * rays.size() + i], pixels[i], images[l]);
+        for (std::size_t i = 0; i < rays.size(); ++i) detail::store_sample(layers[l * rays.size() + i], pixels[i], images[l]);
     });
     return images;
   }
@@ -148,10 +188,10 @@ std::vector<DepthImage> render_depth_images(const SampledScene& scene, Span<cons
     rule.previous = Span<const DepthImage>(images.data(), i);
     rule.previous_cameras = Span<const Camera>(cameras.data(), i);
     DepthImage& image = images.back();
-    detail::for_each_tile(cameras[i], options.threaded, [&](Span<const mesh::RayF> rays, Span<const std::size_t> pixels) {
+    detail::for_each_tile(image, options.threaded, [&](Span<const mesh::RayF> rays, Span<const std::size_t> pixels) {
       std::vector<mesh::Hit> hits(rays.size());
       detail::trace(scene, rule, rays, Span<mesh::Hit>(hits), true);
-      for (std::size_t r = 0; r < rays.size(); ++r) detail::store_sample(scene, rays[r], hits[r], pixels[r], image);
+      for (std::size_t r = 0; r < rays.size(); ++r) detail::store_sample(hits[r], pixels[r], image);
     });
   }
   return images;

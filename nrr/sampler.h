@@ -54,6 +54,9 @@ class SampledScene {
   /// Corner normals interpolated at barycentrics (u, v); `face_normal` (the unit normal of triangle
   /// `id`, e.g. mesh::Hit::normal_ws) for flat triangles or where the interpolation faces away.
   Vec3f shading_normal(mesh::TriangleId id, float u, float v, const Vec3f& face_normal) const;
+  /// shading_normal at the sample point x on triangle `id` hit by a ray from `origin` (barycentrics
+  /// recomputed from x; the face normal as Embree reports it for that ray).
+  Vec3f shading_normal_at(mesh::TriangleId id, const Vec3f& x, const Vec3f& origin) const;
   /// Scene bounding-box diagonal, world units.
   double diagonal() const { return rays_.bounds().diagonal(); }
   /// Mean triangle edge length, world units (for the triangle-size / pixel-size ratio in reports).
@@ -61,11 +64,18 @@ class SampledScene {
 
  private:
   mesh::RayScene rays_;
+  TriMesh mesh_;  ///< for the barycentrics of derived shading normals
   std::vector<Vec3d> face_normals_;
   std::vector<std::array<Vec3f, 3>> corner_normals_;  ///< per triangle, normals at its corners
   std::vector<std::uint8_t> is_flat_;                 ///< per triangle: corner normals == face normal
   double mean_edge_ = 0.0;
 };
+
+enum class NormalKind { Face, Shading };
+
+/// Fills image.normal_ws (the lean record derives normals on demand): per sample the unit normal of
+/// its triangle's front face, or the interpolated shading normal; zero where empty.
+void fill_normals(const SampledScene& scene, DepthImage& image, NormalKind kind);
 
 struct SamplingOptions {
   SamplingMode mode = SamplingMode::NrrPixel;

@@ -65,12 +65,9 @@ std::vector<TriMesh> discretize_and_reconstruct(const SampledScene& scene, const
     for (const CameraSpec& v : views) corner_views.push_back(corner_camera(v));
     corners = render_depth_images(scene, Span<const CameraSpec>(corner_views), sampling);
   }
-  if (options.use_face_normals) {
-    for (std::vector<DepthImage>* set : {&images, &corners})
-      for (DepthImage& image : *set)
-        for (std::size_t p = 0; p < image.pixel_count(); ++p)
-          if (image.has_sample(p)) image.normal_ws[p] = Vec3f(scene.face_normal(image.triangle_id[p]));
-  }
+  const NormalKind normals = options.use_face_normals ? NormalKind::Face : NormalKind::Shading;
+  for (std::vector<DepthImage>* set : {&images, &corners})
+    for (DepthImage& image : *set) fill_normals(scene, image, normals);
   result.times_ms.depth_images = timer.elapsed_ms();
   for (const DepthImage& image : images) result.depth_samples += image.sample_count();
   for (const DepthImage& image : corners) result.corner_samples += image.sample_count();

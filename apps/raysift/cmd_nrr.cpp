@@ -131,7 +131,7 @@ RegisterCommand reg(
           if (r.images[i].sample_count() == 0 && !common.quiet)
             std::cerr << "raysift nrr: warning: image " << i << " holds no sample (does the view look away from "
                       << "the scene?)\n";
-        nrr::write_nrr_outputs(r, o.out_dir, o.mask_dir);
+        nrr::write_nrr_outputs(scene, r, o.out_dir, o.mask_dir);
         if (!common.quiet) std::fputs(nrr::nrr_summary(options, r).c_str(), stdout);
         if (common.verbose)
           std::printf("  times: load %.1f ms, render %.1f ms, metrics %.1f ms\n", load_ms, r.render_ms, r.metrics_ms);

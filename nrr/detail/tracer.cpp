@@ -1,12 +1,10 @@
 #include "nrr/detail/tracer.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 
 #include "core/errors.h"
+#include "core/parallel.h"
 #include "core/tolerances.h"
 
 namespace raysift::nrr::detail {
@@ -198,17 +196,10 @@ void trace_layers(const SampledScene& scene, int k, Span<const mesh::RayF> rays,
       layers[l * rays.size() + i] = l < nearest[i].size() ? to_hit(scene, nearest[i][l]) : mesh::Hit{};
 }
 
-void for_each_tile(const Camera& camera, bool threaded,
+void for_each_tile(const DepthImage& image, bool threaded,
                    const std::function<void(Span<const mesh::RayF> rays, Span<const std::size_t> pixels)>& fn) {
-  const int w = camera.width(), h = camera.height();
+  const int w = image.width, h = image.height;
   const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
-  const Vec3f eye(camera.eye());
-  // Directions are separable: forward + sx(x) * right + sy(y) * up, so a tile needs one column and one
-  // row term per pixel instead of a full camera evaluation.
-  std::vector<Vec3d> column(static_cast<std::size_t>(w)), row(static_cast<std::size_t>(h));
-  const Vec3d centre = camera.direction_unit_depth(0.5 * w, 0.5 * h);
-  for (int x = 0; x < w; ++x) column[std::size_t(x)] = camera.direction_unit_depth(x + 0.5, 0.5 * h) - centre;
-  for (int y = 0; y < h; ++y) row[std::size_t(y)] = camera.direction_unit_depth(0.5 * w, y + 0.5);
   const auto run = [&](int tile) {
     std::vector<mesh::RayF> rays;
     std::vector<std::size_t> pixels;
@@ -219,28 +210,12 @@ void for_each_tile(const Camera& camera, bool threaded,
       for (int bx = x0; bx < std::min(x0 + kTile, w); bx += kBlock)
         for (int y = by; y < std::min(by + kBlock, h); ++y)
           for (int x = bx; x < std::min(bx + kBlock, w); ++x) {
-            rays.push_back({eye, Vec3f(row[std::size_t(y)] + column[std::size_t(x)])});
+            rays.push_back({image.rays.origin(), image.rays.direction(std::size_t(x), std::size_t(y))});
             pixels.push_back(std::size_t(y) * std::size_t(w) + std::size_t(x));
           }
     fn(Span<const mesh::RayF>(rays), Span<const std::size_t>(pixels));
   };
-  const int tiles = tiles_x * tiles_y;
-  if (!threaded) {
-    for (int t = 0; t < tiles; ++t) run(t);
-    return;
-  }
-  tbb::parallel_for(tbb::blocked_range<int>(0, tiles), [&](const tbb::blocked_range<int>& r) {
-    for (int t = r.begin(); t < r.end(); ++t) run(t);
-  });
-}
-
-void store_sample(const SampledScene& scene, const mesh::RayF& ray, const mesh::Hit& h, std::size_t pixel,
-                  DepthImage& image) {
-  if (!h.is_hit()) return;
-  image.depth[pixel] = h.t;
-  image.triangle_id[pixel] = h.triangle_id;
-  image.normal_ws[pixel] = scene.shading_normal(h.triangle_id, h.u, h.v, h.normal_ws);
-  image.position_ws[pixel] = sample_position(ray, h.t);
+  parallel_for_each(tiles_x * tiles_y, run, threaded);
 }
 
 }  // namespace raysift::nrr::detail

@@ -9,11 +9,8 @@
 
 namespace raysift::nrr::detail {
 
-/// The sample point of a hit along a ray, rounded to float exactly once so that the samplers and the
-/// metrics reproject the very same point.
-inline Vec3f sample_position(const mesh::RayF& ray, float t) {
-  return Vec3f(Vec3d(ray.origin) + Vec3d(ray.direction) * double(t));
-}
+/// The sample point of a hit along a ray (sample_point: rounded to float once).
+inline Vec3f sample_position(const mesh::RayF& ray, float t) { return sample_point(ray.origin, ray.direction, t); }
 
 /// Projection of world points to pixel indices of one camera, with the camera basis pre-scaled so a
 /// point costs three dot products and one division (the pixel-redundancy filter runs per candidate).
@@ -79,14 +76,17 @@ void trace(const SampledScene& scene, const ImageRule& rule, Span<const mesh::Ra
 void trace_layers(const SampledScene& scene, int k, Span<const mesh::RayF> rays, Span<mesh::Hit> layers,
                   bool is_coherent);
 
-/// Calls fn(rays, pixels) for tiles of 16x16 pixels whose rays are ordered in 4x4 blocks (one packet
-/// each); rays have direction camera.direction_unit_depth, so t is view depth. Tiles run in parallel
+/// Calls fn(rays, pixels) for tiles of 16x16 pixels of `image` whose rays (image.rays, unit forward
+/// component, so t is view depth) are ordered in 4x4 blocks (one packet each). Tiles run in parallel
 /// when `threaded`; each tile writes only its own pixels.
-void for_each_tile(const Camera& camera, bool threaded,
+void for_each_tile(const DepthImage& image, bool threaded,
                    const std::function<void(Span<const mesh::RayF> rays, Span<const std::size_t> pixels)>& fn);
 
-/// Stores hit `h` of `ray` at `pixel` of `image` (shading normal, position, depth = t).
-void store_sample(const SampledScene& scene, const mesh::RayF& ray, const mesh::Hit& h, std::size_t pixel,
-                  DepthImage& image);
+/// Stores hit `h` at `pixel` of `image`: depth = t and the triangle id (the lean record).
+inline void store_sample(const mesh::Hit& h, std::size_t pixel, DepthImage& image) {
+  if (!h.is_hit()) return;
+  image.depth[pixel] = h.t;
+  image.triangle_id[pixel] = h.triangle_id;
+}
 
 }  // namespace raysift::nrr::detail

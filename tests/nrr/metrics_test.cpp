@@ -76,7 +76,7 @@ TEST_P(Blocks4, OnlyNonRedundantRenderingCapturesBlockC) {
       if (!frame.has_sample(p) || mesh::triangle_id_index(frame.triangle_id[p]) < kFirstTriangleOfC) continue;
       ++c_in_frame;
       for (const DepthImage& im : images)
-        if (detail::pixel_captured(im, Camera(im.camera), frame.position_ws[p], frame.triangle_id[p])) {
+        if (detail::pixel_captured(im, Camera(im.camera), frame.position_ws(p), frame.triangle_id[p])) {
           ++c_available;
           break;
         }

@@ -59,7 +59,7 @@ TEST(Periscope, SampleOccludedFromAnEarlierEyeIsKept) {
     std::size_t occluded_kept = 0, outside_dropped = 0, outside_kept = 0;
     for (std::size_t p = 0; p < conv[1].pixel_count(); ++p) {
       if (!conv[1].has_sample(p) || mesh::triangle_id_index(conv[1].triangle_id[p]) > 1) continue;
-      const WallPoint w = classify_wall_point(cam0, Vec3d(conv[1].position_ws[p]));
+      const WallPoint w = classify_wall_point(cam0, Vec3d(conv[1].position_ws(p)));
       if (w.is_fragile) continue;
       const bool occluded = w.occluded, outside = w.outside;
       const bool expect_kept = occluded || (outside && mode == SamplingMode::NrrVisibilityFrustum);
@@ -99,7 +99,7 @@ TEST(Periscope, MaskSaysWhyEachWallPixelIsRedundant) {
     const MaskClass c = r.masks[1].classes[p];
     ASSERT_EQ(c == MaskClass::Background, !conv[1].has_sample(p));
     if (!conv[1].has_sample(p) || mesh::triangle_id_index(conv[1].triangle_id[p]) > 1) continue;
-    const WallPoint w = classify_wall_point(cam0, Vec3d(conv[1].position_ws[p]));
+    const WallPoint w = classify_wall_point(cam0, Vec3d(conv[1].position_ws(p)));
     if (w.is_fragile) continue;
     // Occluded: kept. In I_0 and in sight: the wall's big triangles are under its pixels, so Alg. 3
     // fires. Outside I_0 but in sight: only Alg. 2 sees the redundancy.

@@ -31,7 +31,7 @@ CameraSpec test_camera() {
 DepthImage plane_image(const CameraSpec& spec, double offset, const std::function<bool(double, double)>& covers,
                        const std::function<double(double, double)>& depth_at) {
   DepthImage image(spec);
-  const Camera cam(spec);
+  image.normal_ws.assign(image.pixel_count(), Vec3f{});
   for (int y = 0; y < spec.height; ++y)
     for (int x = 0; x < spec.width; ++x) {
       const double xs = x + 0.5 - 0.5 + offset, ys = y + 0.5 - 0.5 + offset;
@@ -40,7 +40,6 @@ DepthImage plane_image(const CameraSpec& spec, double offset, const std::functio
       image.depth[p] = float(depth_at(xs, ys));
       image.triangle_id[p] = 0;
       image.normal_ws[p] = Vec3f{0, 0, 1};
-      image.position_ws[p] = Vec3f(cam.direction_unit_depth(x + 0.5, y + 0.5) * double(image.depth[p]));
     }
   return image;
 }

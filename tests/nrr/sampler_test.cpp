@@ -57,8 +57,11 @@ TEST_P(NrrModes, Image0EqualsConventionalImage0BitExactly) {
   const auto nrr = render(scene, views, GetParam());
   EXPECT_EQ(nrr[0].triangle_id, conv[0].triangle_id);
   EXPECT_EQ(0, std::memcmp(nrr[0].depth.data(), conv[0].depth.data(), conv[0].depth.size() * sizeof(float)));
-  EXPECT_EQ(0, std::memcmp(nrr[0].position_ws.data(), conv[0].position_ws.data(),
-                           conv[0].position_ws.size() * sizeof(Vec3f)));
+  for (std::size_t p = 0; p < conv[0].pixel_count(); ++p)
+    if (conv[0].has_sample(p)) {
+      const Vec3f a = nrr[0].position_ws(p), b = conv[0].position_ws(p);
+      ASSERT_EQ(0, std::memcmp(&a, &b, sizeof(Vec3f))) << "pixel " << p;
+    }
 }
 
 TEST_P(NrrModes, NoSampleIsRedundantWithAnEarlierImage) {
@@ -72,7 +75,7 @@ TEST_P(NrrModes, NoSampleIsRedundantWithAnEarlierImage) {
       if (!images[i].has_sample(p)) continue;
       ++checked;
       for (std::size_t j = 0; j < i; ++j) {
-        const Vec3f& x = images[i].position_ws[p];
+        const Vec3f x = images[i].position_ws(p);
         const auto id = images[i].triangle_id[p];
         if (GetParam() == SamplingMode::NrrPixel)
           ASSERT_FALSE(detail::pixel_captured(images[j], cams[j], x, id)) << "image " << i << " pixel " << p;
@@ -96,7 +99,7 @@ TEST_P(NrrModes, ConventionalImage1IsRedundantExactlyWhereNrrDiffers) {
       EXPECT_FALSE(nrr[1].has_sample(p));  // NRR can only remove samples in front, never add rays
       continue;
     }
-    const Vec3f& x = conv[1].position_ws[p];
+    const Vec3f x = conv[1].position_ws(p);
     const auto id = conv[1].triangle_id[p];
     const bool is_redundant = GetParam() == SamplingMode::NrrPixel
                                   ? detail::pixel_captured(conv[0], cam0, x, id)
@@ -114,7 +117,7 @@ TEST_P(NrrModes, BackFacesAreNeverSampled) {
   for (const DepthImage& im : render(scene, views, GetParam()))
     for (std::size_t p = 0; p < im.pixel_count(); ++p)
       if (im.has_sample(p)) {
-        ASSERT_LT(dot(scene.face_normal(im.triangle_id[p]), Vec3d(im.position_ws[p]) - im.camera.eye), 0.0);
+        ASSERT_LT(dot(scene.face_normal(im.triangle_id[p]), Vec3d(im.position_ws(p)) - im.camera.eye), 0.0);
       }
 }
 
@@ -127,6 +130,44 @@ INSTANTIATE_TEST_SUITE_P(Sampler, NrrModes,
                                   : r == Redundancy::Visibility ? "Visibility"
                                                                 : "VisibilityFrustum";
                          });
+
+// The lean record (depth + triangle id) against what the full record stored: the point and the shading
+// normal of an independent trace of each pixel's ray (origin the eye, direction the camera's at the pixel
+// centre, separable as documented), on a smooth sphere (interpolated normals) and on grass (flat blades).
+TEST(Sampler, LeanRecordReconstructsTheFullRecord) {
+  const TriMesh sphere = mesh::make_icosphere(1.0, 3);
+  for (const TriMesh* m : {&sphere, &small_grass().mesh}) {
+    const SampledScene scene(*m);
+    const CameraSpec spec = m == &sphere ? camera({0.3, 0.2, 3.5}, {}, 40, 64) : sized(small_grass().views.views, 64)[0];
+    DepthImage image = render(scene, {spec}, SamplingMode::Conventional)[0];
+    fill_normals(scene, image, NormalKind::Shading);
+    const Camera cam(spec);
+    const Vec3d centre = cam.direction_unit_depth(32, 32);
+    mesh::QueryOptions cull;
+    cull.cull_back_faces = true;
+    std::size_t checked = 0;
+    for (int y = 0; y < 64; ++y)
+      for (int x = 0; x < 64; ++x) {
+        const Vec3d dir = cam.direction_unit_depth(32, y + 0.5) + (cam.direction_unit_depth(x + 0.5, 32) - centre);
+        const mesh::RayF ray{Vec3f(spec.eye), Vec3f(dir)};
+        const mesh::Hit h = scene.rays().intersect(ray, cull);
+        const std::size_t p = std::size_t(y) * 64 + std::size_t(x);
+        ASSERT_EQ(h.triangle_id, image.triangle_id[p]) << "pixel " << p;
+        if (!h.is_hit()) continue;
+        ++checked;
+        // Single-ray and packet traversal may round t differently, by an ulp or so.
+        ASSERT_NEAR(h.t, image.depth[p], 4e-7 * h.t) << "pixel " << p;
+        // The full record stored origin + t * direction of the traced ray, rounded once.
+        const Vec3f full = Vec3f(Vec3d(ray.origin) + Vec3d(ray.direction) * double(image.depth[p]));
+        const Vec3f lean = image.position_ws(p);
+        ASSERT_EQ(0, std::memcmp(&full, &lean, sizeof(Vec3f))) << "pixel " << p;
+        const Vec3f n_full = scene.shading_normal(h.triangle_id, h.u, h.v, h.normal_ws);
+        // Barycentrics recomputed from the float point: the normal agrees to float precision.
+        ASSERT_LT(length(Vec3d(n_full) - Vec3d(image.normal_ws[p])), 1e-5) << "pixel " << p;
+      }
+    EXPECT_GT(checked, 1000u);
+  }
+}
 
 TEST(Sampler, ConvexMeshLaterImagesHoldOnlyWhatEarlierEyesCannotSee) {
   const TriMesh sphere = mesh::make_icosphere(1.0, 2);
@@ -142,7 +183,7 @@ TEST(Sampler, ConvexMeshLaterImagesHoldOnlyWhatEarlierEyesCannotSee) {
       for (std::size_t p = 0; p < conv[i].pixel_count(); ++p) {
         if (!conv[i].has_sample(p)) continue;
         // Convex: a front face is visible from an eye iff it faces that eye.
-        const Vec3d x(conv[i].position_ws[p]);
+        const Vec3d x(conv[i].position_ws(p));
         const Vec3d n = scene.face_normal(conv[i].triangle_id[p]);
         bool is_seen = false;
         for (std::size_t j = 0; j < i; ++j) is_seen = is_seen || dot(n, views[j].eye - x) > 0.0;

@@ -125,8 +125,8 @@ TEST(DepthImageFile, ExrStoresIdsAndDepthExactly) {
   DepthImage im(c);
   im.triangle_id[4] = mesh::make_triangle_id(2, 0x12345u);
   im.depth[4] = 4.25f;
+  im.normal_ws.assign(im.pixel_count(), Vec3f{});
   im.normal_ws[4] = {0, 0, 1};
-  im.position_ws[4] = {0.5f, -0.25f, 0.75f};
   const std::string dir = test::make_temp_dir("depth_image");
   write_depth_image(im, dir + "/d.exr", dir + "/d.png");
   const ChannelImage back = read_channels(dir + "/d.exr");
@@ -141,7 +141,8 @@ TEST(DepthImageFile, ExrStoresIdsAndDepthExactly) {
   EXPECT_EQ(channel("hit", 0), 0.0f);
   EXPECT_EQ(channel("mesh", 4), 2.0f);
   EXPECT_EQ(std::uint32_t(channel("tri_hi", 4)) << 16 | std::uint32_t(channel("tri_lo", 4)), 0x12345u);
-  EXPECT_EQ(channel("P.y", 4), -0.25f);
+  EXPECT_EQ(channel("P.y", 4), im.position_ws(4).y);  // derived from the depth along pixel 4's ray
+  EXPECT_NE(channel("P.y", 4), 0.0f);
 }
 
 TEST(Scenes, GrassAndUrbanHitTheirTriangleTargetsAndDependOnlyOnTheSeed) {
