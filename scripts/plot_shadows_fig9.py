@@ -30,7 +30,7 @@ def main(argv):
     ax.axvline(250, color="grey", linestyle=":", label="paper's crossover (250K)")
     ax.set_xscale("log")
     ax.set_xlabel("grass triangles (thousands)")
-    ax.set_ylabel("end-to-end time (s, wall)")
+    ax.set_ylabel("end-to-end CPU time (s, all threads)")
     ax.set_title("Soft-shadow time vs scene complexity (NRR Fig. 9)")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
