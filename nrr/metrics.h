@@ -24,9 +24,10 @@ struct ImageMetrics {
 
 struct SamplingMetrics {
   std::vector<ImageMetrics> images;
-  double available_avg_pct = 100.0;  ///< (4) mean over frames of % of a frame's samples available
-  double available_min_pct = 100.0;  ///< (4) minimum over frames
-  std::size_t frames_with_samples = 0;  ///< frames entering (4); empty frames are skipped
+  double available_avg_pct = 0.0;  ///< (4) mean over frames of % of a frame's samples available
+  double available_min_pct = 0.0;  ///< (4) minimum over frames
+  /// Frames entering (4); empty frames are skipped, and with none (4) is 0, not a 0/0.
+  std::size_t frames_with_samples = 0;
   std::vector<std::vector<SampleClass>> sample_classes;  ///< per reference image, per pixel
 };
 

@@ -75,15 +75,25 @@ GeneratedScene make_blocks4() {
 }
 
 constexpr int kTrianglesPerBlade = 10;
+constexpr double kFieldHalf = 5.0;  ///< grass and urban stand on the ground |x|, |z| <= 5 at y = 0
+
+/// A scene holding only the ground of grass and urban (two triangles).
+GeneratedScene field_scene() {
+  GeneratedScene s;
+  add_ground(s.mesh, kFieldHalf);
+  return s;
+}
+
+/// How many items of `per_item` triangles fill a `triangles` budget beside the ground's two.
+std::size_t items_beside_ground(std::size_t triangles, int per_item) { return (triangles - 2) / std::size_t(per_item); }
 constexpr double kBladeThickness = 1e-3;  ///< world units; blades are 0.04-0.08 wide
 constexpr int kTrianglesPerBuilding = 10;
 
 GeneratedScene make_grass(std::uint64_t seed, std::size_t triangles) {
-  GeneratedScene s;
+  GeneratedScene s = field_scene();
   TriMesh& m = s.mesh;
-  const double half = 5.0;
-  add_ground(m, half);
-  const std::size_t blades = (triangles - 2) / kTrianglesPerBlade;
+  const double half = kFieldHalf;
+  const std::size_t blades = items_beside_ground(triangles, kTrianglesPerBlade);
   for (std::size_t b = 0; b < blades; ++b) {
     const Vec3d base{(2 * uniform(b, seed, 0) - 1) * (half - 0.5), 0.0, (2 * uniform(b, seed, 1) - 1) * (half - 0.5)};
     const double angle = 2 * M_PI * uniform(b, seed, 2);
@@ -122,11 +132,10 @@ GeneratedScene make_grass(std::uint64_t seed, std::size_t triangles) {
 }
 
 GeneratedScene make_urban(std::uint64_t seed, std::size_t triangles) {
-  GeneratedScene s;
+  GeneratedScene s = field_scene();
   TriMesh& m = s.mesh;
-  const double half = 5.0;
-  add_ground(m, half);
-  const std::size_t buildings = (triangles - 2) / kTrianglesPerBuilding;
+  const double half = kFieldHalf;
+  const std::size_t buildings = items_beside_ground(triangles, kTrianglesPerBuilding);
   const auto grid = std::size_t(std::ceil(std::sqrt(double(buildings))));
   const double cell = 2 * half / double(grid);
   for (std::size_t b = 0; b < buildings; ++b) {

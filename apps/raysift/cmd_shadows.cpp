@@ -1,19 +1,14 @@
 // raysift shadows: soft shadows of a rectangular area light on a triangle mesh (NRR Alg. 5); maps the
-// flags onto nrr/shadow_pipeline.h, resolves the inputs (mesh, light, camera) and writes the results.
+// flags onto nrr/shadow_pipeline.h and writes the results.
 #include <cstdio>
-#include <filesystem>
 #include <memory>
-#include <optional>
 
 #include "apps/raysift/cli_checks.h"
 #include "apps/raysift/command.h"
 #include "core/output_set.h"
 #include "core/file_util.h"
 #include "core/image.h"
-#include "core/scene.h"
 #include "core/timer.h"
-#include "mesh/mesh_io.h"
-#include "nrr/scenes.h"
 #include "nrr/shadow_pipeline.h"
 
 namespace raysift::app {
@@ -49,11 +44,6 @@ const std::map<std::string, nrr::Redundancy> kRedundancies = {
     {"pixel", nrr::Redundancy::Pixel},
     {"visibility", nrr::Redundancy::Visibility},
     {"visibility-frustum", nrr::Redundancy::VisibilityFrustum}};
-
-Json errors_json(const nrr::ShadowErrors& e) {
-  return Json{{"visibility_error_avg", e.visibility_error_avg}, {"visibility_error_max", e.visibility_error_max},
-              {"intensity_error_avg", e.intensity_error_avg},   {"intensity_error_max", e.intensity_error_max}};
-}
 
 void add_options(CLI::App& sub, ShadowsOptions& o) {
   nrr::ShadowOptions& s = o.lib.shadow;
@@ -100,83 +90,18 @@ void add_options(CLI::App& sub, ShadowsOptions& o) {
              "--reference shadowmap --error-map err.png --stats stats.json\n");
 }
 
-/// The mesh, the light and the output camera from the flags, the scene file or a built-in scene.
-struct ShadowInputs {
-  TriMesh mesh;
-  nrr::AreaLight light;
-  std::optional<CameraSpec> camera;  ///< none = the default view from the light side
-};
-
-ShadowInputs load_inputs(const ShadowsOptions& o, const CommonOptions& common) {
-  ShadowInputs in;
-  const bool is_scene_file = file_extension(o.input) == ".json";
-  const std::string scene_path = is_scene_file ? o.input : common.scene_path;
-  const Scene scene = scene_path.empty() ? Scene{} : load_scene(scene_path);
-  if (is_scene_file) {
-    if (scene.mesh.empty()) throw InvalidInput(file_message(scene_path, "the scene has no 'mesh' key"));
-    in.mesh = mesh::read_mesh(scene.mesh);
-  } else if (!std::filesystem::exists(o.input) && (o.input == "grass" || o.input == "urban" || o.input == "blocks4")) {
-    nrr::SceneOptions so;
-    so.seed = common.seed;
-    nrr::GeneratedScene generated = nrr::make_scene(nrr::parse_scene_kind(o.input), so);
-    in.mesh = std::move(generated.mesh);
-    in.camera = generated.views.views.at(0);
-    in.camera->width = o.width;
-    in.camera->height = o.height;
-  } else {
-    in.mesh = mesh::read_mesh(o.input);
-  }
-  if (!o.light.empty()) {
-    in.light = nrr::area_light_from_json(read_json_file(o.light), o.light);
-  } else if (!scene.light.is_null()) {
-    in.light = nrr::area_light_from_json(scene.light, scene.light_source + ": light");
-  } else {
-    throw UsageError("no light: give --light L.json (or a scene with a 'light'); see --help");
-  }
-  if (!o.camera.empty()) {
-    in.camera = camera_spec_from_json(read_json_file(o.camera), o.camera);
-  } else if (scene.camera) {
-    in.camera = scene.camera;
-  }
-  return in;
-}
-
-void print_and_write(const ShadowsOptions& o, const CommonOptions& common, const nrr::ShadowPipelineResult& run,
-                     const Json& light, std::size_t scene_triangles, double total_ms) {
-  const nrr::ShadowOptions& s = o.lib.shadow;
-  const nrr::ShadowResult& r = run.result;
-  const std::string method = nrr::to_string(o.lib.method), reference = nrr::to_string(o.lib.reference);
-  Json stats = errors_json(run.errors);
-  stats["method"] = method;
-  stats["reference"] = reference;
-  if (o.lib.method == nrr::ShadowMethod::Nrr) stats["redundancy"] = nrr::to_string(s.nrr_redundancy);
-  stats["counted_pixels"] = run.errors.counted_pixels;
-  stats["light"] = light;
-  stats["light_samples"] = s.light_samples_per_side * s.light_samples_per_side;
-  stats["scene_triangles"] = scene_triangles;
-  stats["occluder_triangles"] = r.occluder_triangles;
-  stats["depth_samples"] = r.depth_samples;
-  stats["corner_samples"] = r.corner_samples;
-  stats["reconstruction"] = Json{{"triangles", r.reconstruction.triangles},
-                                 {"shared_corners", r.reconstruction.shared_corners},
-                                 {"estimated_corners", r.reconstruction.estimated_corners},
-                                 {"isolated_samples", r.reconstruction.isolated_samples}};
-  stats["depth_image_resolution"] = s.depth_image_resolution;
-  stats["shadow_map_resolution"] = s.shadow_map_resolution;
-  stats["times_ms"] = Json{{"depth_images", r.times_ms.depth_images}, {"reconstruction", r.times_ms.reconstruction},
-                           {"shadows", r.times_ms.shadows},           {"receivers", run.receivers_ms},
-                           {"reference", run.reference_ms},           {"total", total_ms}};
-  if (run.reference_vs_raytrace) stats["reference_vs_raytrace"] = errors_json(*run.reference_vs_raytrace);
-  if (run.method_vs_raytrace) stats["method_vs_raytrace"] = errors_json(*run.method_vs_raytrace);
+void print_summary(const nrr::ShadowPipelineOptions& o, const nrr::ShadowPipelineResult& run, bool verbose) {
   const nrr::ShadowErrors& e = run.errors;
-  if (!common.quiet)
-    std::printf("%s vs %s: visibility error %.3f (max %.1f), intensity error %.3f (max %.1f) over %zu pixels\n",
-                method.c_str(), reference.c_str(), e.visibility_error_avg, e.visibility_error_max,
-                e.intensity_error_avg, e.intensity_error_max, e.counted_pixels);
-  if (common.verbose)
+  if (run.light_clamped)
+    std::fprintf(stderr, "raysift shadows: warning: the light is larger than %.0f scene diagonals; shrunk to that "
+                 "size about its centre (docs/cli.md)\n", nrr::kMaxLightDiagonalRel);
+  std::printf("%s vs %s: visibility error %.3f (max %.1f), intensity error %.3f (max %.1f) over %zu pixels\n",
+              nrr::to_string(o.method).c_str(), nrr::to_string(o.reference).c_str(), e.visibility_error_avg,
+              e.visibility_error_max, e.intensity_error_avg, e.intensity_error_max, e.counted_pixels);
+  const nrr::ShadowResult& r = run.result;
+  if (verbose)
     std::printf("times: depth images %.1f ms, reconstruction %.1f ms, shadows %.1f ms, reference %.1f ms\n",
                 r.times_ms.depth_images, r.times_ms.reconstruction, r.times_ms.shadows, run.reference_ms);
-  write_stats_if_requested(common, stats);
 }
 
 RegisterCommand reg(
@@ -189,10 +114,11 @@ RegisterCommand reg(
         options.shadow.depth_image_resolution = opt->resolution;
         options.shadow.shadow_map_resolution = opt->shadow_map_resolution > 0 ? opt->shadow_map_resolution : opt->resolution;
         options.shadow.use_face_normals = !opt->shading_normals;
-        opt->lib.shadow = options.shadow;
 
         Timer total;
-        ShadowInputs in = load_inputs(*opt, common);
+        nrr::ShadowInputSpec spec{opt->input, opt->light, opt->camera, common.scene_path, common.seed, opt->width,
+                                  opt->height};
+        nrr::ShadowInputs in = nrr::load_shadow_inputs(spec);
         const nrr::SampledScene sampled(in.mesh);
         const Bbox3d bounds = sampled.rays().bounds();
         if (opt->light_size > 0.0) in.light = nrr::rescale_light(in.light, opt->light_size * bounds.diagonal());
@@ -211,7 +137,9 @@ RegisterCommand reg(
           write_image(outputs.stage(opt->error_map),
                       nrr::error_map_image(run.errors, run.receivers.width, run.receivers.height));
         outputs.commit();
-        print_and_write(*opt, common, run, nrr::area_light_to_json(in.light), in.mesh.triangle_count(), total.elapsed_ms());
+        if (!common.quiet) print_summary(options, run, common.verbose);
+        write_stats_if_requested(common, nrr::shadow_stats_json(options, run, in.mesh.triangle_count(),
+                                                                total.elapsed_ms()));
       };
     });
 

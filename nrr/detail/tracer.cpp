@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/errors.h"
 #include "core/parallel.h"
@@ -14,6 +15,7 @@ namespace {
 /// same surface point hit on a shared edge; one of them is dropped (ALGORITHMS.md §10).
 constexpr float kSameHitRelative = 1e-6f;
 constexpr int kTile = 16;
+constexpr float kInfinityF = std::numeric_limits<float>::infinity();
 constexpr int kBlock = 4;
 
 struct Candidate {
@@ -98,6 +100,87 @@ bool visibility_redundant(const SampledScene& scene, const Camera& camera, Redun
   return may_be_visibility_redundant(scene, camera, redundancy, x, id) && line_of_sight(scene, camera.eye(), x, id);
 }
 
+namespace {
+
+/// Marks redundant[k] = 1 for the faces found[k] (hit along rays[active[k]]) that are redundant.
+using RedundancyMarker = std::function<void(Span<const mesh::Hit> found, Span<const std::size_t> active,
+                                            std::vector<std::uint8_t>& redundant)>;
+
+/// Alg. 1 peeling front faces in rounds: each round traces, for every unresolved ray, the nearest front
+/// face beyond the last redundant one (the fast culled path, 16-wide packets) and asks `mark` about all
+/// of them at once; a ray is resolved by its first non-redundant face or a miss.
+void trace_in_rounds(const SampledScene& scene, Span<const mesh::RayF> rays, Span<mesh::Hit> hits,
+                     const mesh::QueryOptions& culled, const RedundancyMarker& mark) {
+  std::vector<mesh::RayF> current(rays.begin(), rays.end()), batch;
+  std::vector<std::size_t> active(rays.size());
+  for (std::size_t i = 0; i < rays.size(); ++i) active[i] = i;
+  std::vector<mesh::Hit> found;
+  std::vector<std::uint8_t> redundant;
+  // Beyond a redundant face the nearest face is often a back face (the far side of a slab or box),
+  // which makes the two-pass culled query trace twice: later rounds cull inside one traversal, which
+  // a filter that accepts everything selects.
+  const mesh::HitFilter accept_all = [](const mesh::HitCandidate&) { return true; };
+  mesh::QueryOptions culled_once = culled;
+  culled_once.filter = &accept_all;
+  for (bool is_first = true; !active.empty(); is_first = false) {
+    batch.clear();
+    for (std::size_t a : active) batch.push_back(current[a]);
+    found.assign(batch.size(), mesh::Hit{});
+    scene.rays().intersect(Span<const mesh::RayF>(batch), Span<mesh::Hit>(found), is_first ? culled : culled_once);
+    redundant.assign(active.size(), 0);
+    mark(Span<const mesh::Hit>(found), Span<const std::size_t>(active), redundant);
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < active.size(); ++k) {
+      const std::size_t a = active[k];
+      if (!found[k].is_hit() || !redundant[k]) {
+        hits[a] = found[k];
+        continue;
+      }
+      // Beyond this face; a second report of the same point (a shared edge) is the same sample.
+      const float t = found[k].t;
+      current[a].t_near = std::max(std::nextafter(t, kInfinityF), t * (1.0f + kSameHitRelative));
+      active[kept++] = a;
+    }
+    active.resize(kept);
+  }
+}
+
+/// Visibility (Alg. 2 or its frustum variant) of a round's faces: coherent occlusion packets
+/// (rtcOccluded16), one earlier camera at a time so a packet's rays share their origin, and only for
+/// faces no earlier camera has shown redundant; a face facing away from the eye (or, for the frustum
+/// variant, outside the frustum) needs no ray.
+RedundancyMarker visibility_marker(const SampledScene& scene, const ImageRule& rule, Span<const mesh::RayF> rays,
+                                   bool is_coherent) {
+  return [&scene, &rule, rays, is_coherent](Span<const mesh::Hit> found, Span<const std::size_t> active,
+                                            std::vector<std::uint8_t>& redundant) {
+    const Redundancy redundancy = redundancy_of(rule.mode);
+    mesh::QueryOptions occluders;
+    occluders.cull_back_faces = true;  // back faces do not occlude: the culled images cannot show them
+    occluders.is_coherent = is_coherent;
+    std::vector<mesh::RayF> shadow;
+    std::vector<std::size_t> owner;
+    std::vector<std::uint8_t> blocked;
+    for (const Camera& cam : rule.previous_cameras) {
+      const Vec3f eye(cam.eye());
+      shadow.clear();
+      owner.clear();
+      for (std::size_t k = 0; k < active.size(); ++k) {
+        if (!found[k].is_hit() || redundant[k]) continue;
+        const Vec3f x = sample_position(rays[active[k]], found[k].t);
+        if (!may_be_visibility_redundant(scene, cam, redundancy, x, found[k].triangle_id)) continue;
+        shadow.push_back({eye, x - eye, 0.0f, 1.0f - float(tol::kSegmentEndRelative)});
+        owner.push_back(k);
+      }
+      blocked.assign(shadow.size(), 0);
+      scene.rays().occluded(Span<const mesh::RayF>(shadow), Span<std::uint8_t>(blocked), occluders);
+      for (std::size_t r = 0; r < shadow.size(); ++r)
+        if (!blocked[r]) redundant[owner[r]] = 1;
+    }
+  };
+}
+
+}  // namespace
+
 void trace(const SampledScene& scene, const ImageRule& rule, Span<const mesh::RayF> rays, Span<mesh::Hit> hits,
            bool is_coherent) {
   mesh::QueryOptions options;
@@ -120,7 +203,8 @@ void trace(const SampledScene& scene, const ImageRule& rule, Span<const mesh::Ra
         return true;
       };
       // The filter is pure, but QueryOptions::is_filter_pure stays off: redundancy rejects 15-50 % of
-      // the nearest hits of later images, and re-tracing those measured slower than one filtered pass.
+      // the nearest hits of later images, and re-tracing those (from scratch, or in rounds beyond the
+      // rejected face as visibility does) measured slower than one filtered pass: 1.7x vs 1.4x on grass.
       options.filter = &keep_non_redundant;
       scene.rays().intersect(rays, hits, options);
       return;
@@ -131,41 +215,7 @@ void trace(const SampledScene& scene, const ImageRule& rule, Span<const mesh::Ra
         scene.rays().intersect(rays, hits, options);
         return;
       }
-      // A candidate facing away from every earlier eye (or, with the frustum variant, outside every
-      // earlier frustum) is surely non-redundant and is accepted at once (pruning the traversal); the
-      // others are collected and tested with occlusion rays after the traversal, nearest first.
-      const Redundancy redundancy = redundancy_of(rule.mode);
-      std::vector<std::vector<Candidate>> maybe(rays.size());
-      const mesh::HitFilter collect = [&](const mesh::HitCandidate& c) {
-        const Vec3f x = sample_position(rays[c.ray_index], c.t);
-        for (const Camera& cam : rule.previous_cameras)
-          if (may_be_visibility_redundant(scene, cam, redundancy, x, c.triangle_id)) {
-            maybe[c.ray_index].push_back(to_candidate(c));
-            return false;
-          }
-        return true;
-      };
-      options.filter = &collect;
-      scene.rays().intersect(rays, hits, options);
-      for (std::size_t i = 0; i < rays.size(); ++i) {
-        std::vector<Candidate>& list = maybe[i];
-        std::sort(list.begin(), list.end());
-        list.erase(std::unique(list.begin(), list.end(),
-                               [](const Candidate& a, const Candidate& b) { return a.id == b.id; }),
-                   list.end());
-        for (const Candidate& c : list) {
-          if (!(c.t < hits[i].t)) break;
-          const Vec3f x = sample_position(rays[i], c.t);
-          const bool is_redundant = std::any_of(rule.previous_cameras.begin(), rule.previous_cameras.end(),
-                                                [&](const Camera& cam) {
-                                                  return visibility_redundant(scene, cam, redundancy, x, c.id);
-                                                });
-          if (!is_redundant) {
-            hits[i] = to_hit(scene, c);
-            break;
-          }
-        }
-      }
+      trace_in_rounds(scene, rays, hits, options, visibility_marker(scene, rule, rays, is_coherent));
       return;
     }
     case SamplingMode::Peel: {

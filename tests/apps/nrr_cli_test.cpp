@@ -78,5 +78,59 @@ TEST(NrrCli, BadInputFailsWithACodeAndNoStats) {
   EXPECT_FALSE(fs::exists(dir + "/forest.ply"));
 }
 
+TEST(NrrCli, CoincidentEyesExitOneNamingTheViews) {
+  const std::string dir = test::make_temp_dir("nrr_cli_eyes");
+  ASSERT_EQ(raysift(dir, "make-scene blocks4 -o b4.ply").code, 0);
+  const CliRun r = raysift(dir, "nrr b4.ply --view-region triangle --eyes \"-4,0,10;4,0,10;-4,0,10\" --target 0,0,0 "
+                                "--resolution 16 -o out --mask-dir masks --stats s.json");
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("views 0 and 2 have coincident eyes"), std::string::npos) << r.err;
+  for (const char* path : {"/out", "/masks", "/s.json"}) EXPECT_FALSE(fs::exists(dir + path)) << path;
+}
+
+TEST(NrrCli, ViewsThatSeeNoTriangleGiveEmptyImagesAndZeroMetrics) {
+  const std::string dir = test::make_temp_dir("nrr_cli_away");
+  ASSERT_EQ(raysift(dir, "make-scene blocks4 -o b4.ply").code, 0);
+  // Both eyes look away from the blocks (which lie around z = 0 to 6).
+  const CliRun r = raysift(dir, "nrr b4.ply --view-region segment --eyes \"-1,0,20;1,0,20\" --target 0,0,40 "
+                                "--resolution 24 --intermediate-views 4 -o out --mask-dir masks --stats s.json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string text = test::read_text(dir + "/s.json");
+  EXPECT_EQ(text.find("null"), std::string::npos) << text;  // nlohmann writes NaN and Inf as null
+  const Json s = read_json_file(dir + "/s.json");
+  for (const Json& image : s["images"]) {
+    for (const char* key : {"samples", "redundant", "disoccluded", "useful"}) EXPECT_EQ(image[key].get<long>(), 0) << key;
+    EXPECT_EQ(image["mask"]["background"].get<long>(), 24 * 24);
+  }
+  EXPECT_EQ(s["view_dependent"]["available_avg_pct"].get<double>(), 0.0);
+  EXPECT_EQ(s["view_dependent"]["available_min_pct"].get<double>(), 0.0);
+  EXPECT_EQ(s["view_dependent"]["frames_with_samples"].get<long>(), 0);
+  EXPECT_TRUE(fs::exists(dir + "/out/image_1.exr"));
+  EXPECT_TRUE(fs::exists(dir + "/masks/mask_1.png"));
+}
+
+TEST(NrrCli, MaskDirWritesOneMaskPerImageCountingEveryPixel) {
+  const std::string dir = test::make_temp_dir("nrr_cli_mask");
+  ASSERT_EQ(raysift(dir, "make-scene blocks4 -o b4.ply").code, 0);
+  const CliRun r = raysift(dir, "nrr b4.ply --views b4.views.json --resolution 64 --no-metrics --mask-dir masks "
+                                "--stats s.json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Json s = read_json_file(dir + "/s.json");
+  EXPECT_EQ(s["mask_visibility"].get<std::string>(), "visibility");
+  for (std::size_t i = 0; i < s["images"].size(); ++i) {
+    const Json& m = s["images"][i]["mask"];
+    long total = 0;
+    for (const char* key : {"kept", "redundant_by_pixel", "redundant_by_visibility", "background"})
+      total += m[key].get<long>();
+    EXPECT_EQ(total, 64 * 64);
+    EXPECT_TRUE(fs::exists(dir + "/masks/mask_" + std::to_string(i) + ".png"));
+  }
+  EXPECT_EQ(s["images"][0]["mask"]["redundant_by_pixel"].get<long>(), 0);  // image 0 is conventional
+  EXPECT_GT(s["images"][1]["mask"]["redundant_by_pixel"].get<long>(), 0);
+  const CliRun peel = raysift(dir, "nrr b4.ply --views b4.views.json --mode peel --resolution 16 --mask-dir pm");
+  EXPECT_EQ(peel.code, 2) << peel.err;
+  EXPECT_FALSE(fs::exists(dir + "/pm"));
+}
+
 }  // namespace
 }  // namespace raysift

@@ -140,6 +140,7 @@ TEST(ShadowsCli, BadInputFailsWithTheRightCodeAndNoOutput) {
       {"shadows b4.ply --light broken.json --method raytrace -o o3.exr", 1},
       {"shadows b4.ply --light missing.json --method raytrace -o o4.exr", 1},
       {"shadows b4.ply --light light.json --method raytrace --resolution 0 -o o5.exr", 2},
+      {"shadows b4.ply --light light.json --method nrr --resolution 16385 -o o6.exr", 2},
   };
   std::vector<std::string> args;
   for (const Case& c : cases) args.push_back(c.args + " --width 16 --height 16");
@@ -149,6 +150,32 @@ TEST(ShadowsCli, BadInputFailsWithTheRightCodeAndNoOutput) {
     EXPECT_NE(runs[i].err.find("error"), std::string::npos) << cases[i].args;
     EXPECT_FALSE(fs::exists(dir + "/o" + std::to_string(i) + ".exr")) << cases[i].args;
   }
+}
+
+// A light far larger than the scene: shrunk about its centre to kMaxLightDiagonalRel (4) scene diagonals,
+// said on stderr and in the stats, and the depth-image methods still see the scene (unclamped, a light 100
+// diagonals across leaves the corner images empty and nrr fails).
+TEST(ShadowsCli, LightLargerThanTheSceneIsClampedToFourDiagonals) {
+  const std::string dir = make_blocks4_dir("shadows_cli_huge");
+  const CliRun r = raysift(dir, "shadows b4.ply --light light.json --light-size 100 --method nrr --light-samples 2 "
+                                "--resolution 48 --width 24 --height 24 -o o.exr --stats s.json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("larger than 4 scene diagonals"), std::string::npos) << r.err;
+  const Json s = read_json_file(dir + "/s.json");
+  EXPECT_TRUE(s["light_clamped"].get<bool>());
+  const auto edge = [&](const char* key) {
+    const Json& e = s["light"][key];
+    return Vec3d{e[0].get<double>(), e[1].get<double>(), e[2].get<double>()};
+  };
+  const CliRun unclamped = raysift(dir, "shadows b4.ply --light light.json --light-size 4 --method raytrace "
+                                        "--light-samples 2 --width 24 --height 24 -o r.exr --stats r.json");
+  ASSERT_EQ(unclamped.code, 0) << unclamped.err;
+  const Json ref = read_json_file(dir + "/r.json");
+  EXPECT_FALSE(ref.contains("light_clamped"));
+  const Vec3d ref_u{ref["light"]["edge_u"][0].get<double>(), ref["light"]["edge_u"][1].get<double>(),
+                    ref["light"]["edge_u"][2].get<double>()};
+  EXPECT_NEAR(length(edge("edge_u") - ref_u), 0.0, 1e-9 * length(ref_u));  // exactly the 4-diagonal light
+  EXPECT_GT(s["depth_samples"].get<long>(), 0);
 }
 
 }  // namespace

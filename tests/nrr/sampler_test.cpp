@@ -236,6 +236,24 @@ TEST(Sampler, OneTraversalPeelingMatchesAnalyticLayers) {
   }
 }
 
+TEST(Sampler, PeelingLayersStrictlyIncreaseInDepthPerPixel) {
+  const SampledScene scene(small_grass().mesh);
+  const auto views = sized(small_grass().views.views, 96);
+  const auto layers = render(scene, views, SamplingMode::Peel, 5);
+  std::size_t deep = 0;
+  for (std::size_t p = 0; p < layers[0].pixel_count(); ++p)
+    for (std::size_t l = 1; l < layers.size(); ++l) {
+      if (!layers[l - 1].has_sample(p)) {
+        ASSERT_FALSE(layers[l].has_sample(p)) << "a layer behind an empty one, pixel " << p;
+        continue;
+      }
+      if (!layers[l].has_sample(p)) continue;
+      ASSERT_GT(layers[l].depth[p], layers[l - 1].depth[p]) << "layer " << l << " pixel " << p;
+      ++deep;
+    }
+  EXPECT_GT(deep, 500u);  // pairs of consecutive layers compared (763 on this field)
+}
+
 TEST(Sampler, CoincidentEyesGiveTheSecondPeelingLayer) {
   const SampledScene scene(quad_stack());
   const CameraSpec c = camera({0.013, 0.021, 10}, {0.013, 0.021, 0}, 20, 48);
