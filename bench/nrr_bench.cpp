@@ -7,7 +7,7 @@
 //    redundancy, three images, the given intermediate frames), each cell beside the paper's value;
 //    Table 2 again with visibility redundancy as the resolution-independent limit (not in the paper).
 //
-// Usage: nrr_bench [--res 1024] [--metrics-res 1024] [--frames 200] [--vis-res 256] [--vis-frames 20]
+// Usage: nrr_bench [res metrics_res frames] [--res 1024] [--metrics-res 1024] [--frames 200] [--vis-res 256] [--vis-frames 20]
 //                  [--scenes grass,urban,dragon_tower,lucy_like] [--no-metrics]
 // The paper's setting is --metrics-res 1024 --frames 1000 (about an hour here); the default of 200 frames is the
 // coarser setting that fits in 20 minutes on 2 cores, and the bench prints which one ran.
@@ -74,8 +74,14 @@ struct Args {
 };
 
 bool parse_args(int argc, char** argv, Args& a) {
+  int positional = 0;  // the old form, still in older notes: nrr_bench [res] [metrics_res] [frames]
   for (int i = 1; i < argc; ++i) {
     const bool v = i + 1 < argc;
+    if (argv[i][0] >= '0' && argv[i][0] <= '9' && positional < 3) {
+      int* slots[3] = {&a.res, &a.metrics_res, &a.frames};
+      *slots[positional++] = std::atoi(argv[i]);
+      continue;
+    }
     if (!std::strcmp(argv[i], "--res") && v) a.res = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--metrics-res") && v) a.metrics_res = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--frames") && v) a.frames = std::atoi(argv[++i]);
