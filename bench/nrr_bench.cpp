@@ -9,7 +9,7 @@
 //
 // Usage: nrr_bench [res metrics_res frames] [--res 1024] [--metrics-res 1024] [--frames 1000] [--vis-res 256]
 //                  [--vis-frames 20] [--scenes grass,urban,dragon_tower,lucy_like] [--no-metrics]
-// The default is the paper's setting (1024^2, 1000 frames): about 30 CPU minutes, i.e. about 15 minutes on 2
+// The default is the paper's setting (1024^2, 1000 frames): about 25 CPU minutes, i.e. about 13 minutes on 2
 // free cores; a coarser --frames (100 on a loaded machine) prints that it is coarser.
 #include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
