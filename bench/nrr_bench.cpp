@@ -1,54 +1,114 @@
-// Non-redundant rendering benchmark (issue 7). For grass, urban and one real mesh, with the same three
-// views in one run: render time of nrr-pixel and nrr-visibility relative to conventional images
-// (target: nrr-pixel <= 1.5x), the conventional sampler's rays/s relative to bare Embree rtcIntersect16
-// primary rays on the same mesh and camera (target >= 50%), and the paper's Table 1 and Table 2
-// (Xie, Wang & Popescu 2016) with pixel redundancy, plus Table 2 with visibility redundancy.
+// Non-redundant rendering benchmark (issue 14). For grass, urban (nrr/scenes.h) and the held-out dragon tower
+// and Lucy-like statue (bench/heldout_scenes.h), with the same three views in one run:
+//  * render CPU time of each NRR variant relative to conventional images per 3-image set (targets: nrr-pixel
+//    <= 1.5x, nrr-visibility <= 2.5x), and the conventional sampler's rays/s relative to bare Embree
+//    rtcIntersect16 primary rays on the same mesh and camera, timed in the same run (target >= 50%);
+//  * the paper's Table 1 and Table 2 (Xie, Wang & Popescu 2016) in the paper's configuration (pixel
+//    redundancy, three images, the given intermediate frames), each cell beside the paper's value;
+//    Table 2 again with visibility redundancy as the resolution-independent limit (not in the paper).
 //
-// Usage: nrr_bench [resolution=1024] [metrics_resolution=512] [intermediate_views=100] [real_mesh]
+// Usage: nrr_bench [res metrics_res frames] [--res 1024] [--metrics-res 1024] [--frames 1000] [--vis-res 256]
+//                  [--vis-frames 20] [--scenes grass,urban,dragon_tower,lucy_like] [--no-metrics]
+// The default is the paper's setting (1024^2, 1000 frames): about 25 CPU minutes, i.e. about 13 minutes on 2
+// free cores; a coarser --frames (100 on a loaded machine) prints that it is coarser.
 #include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
-#include <ctime>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
 #include <string>
 #include <vector>
 
 #include "bench/bench_data.h"
+#include "bench/heldout_scenes.h"
 #include "core/timer.h"
-#include "mesh/mesh_io.h"
 #include "nrr/metrics.h"
+#include "nrr/nrr_pipeline.h"
 #include "nrr/sampler.h"
 #include "nrr/scenes.h"
 
 namespace {
 
 using namespace raysift;
+using bench::NamedScene;
 
-struct BenchScene {
-  std::string name;
-  TriMesh mesh;
-  std::vector<CameraSpec> views;
+// The paper's numbers, typed from Xie, Wang & Popescu 2016 (Vis. Comput.), Tables 1 and 2 (pixel redundancy,
+// 1024^2 images, three views, 1000 intermediate frames). Rows: BirdNest, Grass, Urban, Tree.
+struct PaperCell {
+  int pct, useful_pct;  ///< useful_pct < 0: no useful value in that row
+};
+struct PaperModel {
+  const char* name;
+  PaperCell redundant_conv[3];  ///< Table 1, "Redundant samples for conventional sampling"
+  PaperCell nrr[3];             ///< Table 1, "Disoccluded and (useful) samples for non-redundant rendering"
+  PaperCell peel[3];            ///< Table 1, "Disoccluded and (useful) samples for depth peeling"
+  int available[3][2];          ///< Table 2, avg and min %: conventional, non-redundant, depth peeling
+};
+const PaperModel kPaper[] = {
+    {"BirdNest", {{0, -1}, {70, -1}, {80, -1}}, {{0, 0}, {62, 89}, {76, 86}}, {{10, 99}, {46, 2}, {52, 71}},
+     {{90, 89}, {93, 92}, {92, 89}}},
+    {"Grass", {{0, -1}, {54, -1}, {69, -1}}, {{0, 0}, {56, 85}, {75, 80}}, {{15, 99}, {51, 4}, {71, 79}},
+     {{86, 81}, {96, 91}, {93, 88}}},
+    {"Urban", {{0, -1}, {82, -1}, {84, -1}}, {{0, 0}, {73, 40}, {80, 23}}, {{1, 100}, {78, 7}, {88, 8}},
+     {{97, 96}, {98, 97}, {96, 91}}},
+    {"Tree", {{0, -1}, {23, -1}, {35, -1}}, {{0, 0}, {84, 99}, {88, 98}}, {{44, 99}, {63, 98}, {72, 97}},
+     {{55, 53}, {59, 57}, {55, 48}}},
+};
+constexpr int kPaperResolution = 1024, kPaperFrames = 1000;
+
+const PaperModel* paper_model(const std::string& scene) {
+  for (const PaperModel& m : kPaper)
+    if (scene == m.name) return &m;
+  return nullptr;
+}
+
+struct Args {
+  int res = 1024, metrics_res = 1024, frames = 1000, vis_res = 256, vis_frames = 20;
+  std::string scenes = "grass,urban,dragon_tower,lucy_like";
+  bool with_metrics = true;
 };
 
-/// Three eyes on a triangle in front of and above the mesh, looking at its centre.
-std::vector<CameraSpec> views_around(const TriMesh& m) {
-  Bbox3d box;
-  for (const Vec3f& p : m.positions) box.expand(Vec3d(p));
-  const Vec3d c = box.center();
-  const double d = box.diagonal();
-  std::vector<CameraSpec> views;
-  for (const Vec3d& offset : {Vec3d{-0.35, 0.3, 1.0}, Vec3d{0.35, 0.3, 1.0}, Vec3d{0.0, 0.6, 0.9}}) {
-    CameraSpec v;
-    v.eye = c + offset * (1.3 * d);
-    v.target = c;
-    v.up = {0, 1, 0};
-    v.fov_y_deg = 40.0;
-    views.push_back(v);
+bool parse_args(int argc, char** argv, Args& a) {
+  int positional = 0;  // the old form, still in older notes: nrr_bench [res] [metrics_res] [frames]
+  for (int i = 1; i < argc; ++i) {
+    const bool v = i + 1 < argc;
+    if (argv[i][0] >= '0' && argv[i][0] <= '9' && positional < 3) {
+      int* slots[3] = {&a.res, &a.metrics_res, &a.frames};
+      *slots[positional++] = std::atoi(argv[i]);
+      continue;
+    }
+    if (!std::strcmp(argv[i], "--res") && v) a.res = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--metrics-res") && v) a.metrics_res = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--frames") && v) a.frames = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--vis-res") && v) a.vis_res = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--vis-frames") && v) a.vis_frames = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--scenes") && v) a.scenes = argv[++i];
+    else if (!std::strcmp(argv[i], "--no-metrics")) a.with_metrics = false;
+    else return false;
   }
-  return views;
+  return a.res > 0 && a.metrics_res > 0 && a.frames > 0 && a.vis_res >= 0 && a.vis_frames > 0;
+}
+
+std::vector<NamedScene> load_scenes(const std::string& wanted) {
+  std::vector<NamedScene> scenes;
+  for (auto kind : {nrr::SceneKind::Grass, nrr::SceneKind::Urban}) {
+    const std::string name = kind == nrr::SceneKind::Grass ? "Grass" : "Urban";
+    if (wanted.find(kind == nrr::SceneKind::Grass ? "grass" : "urban") == std::string::npos) continue;
+    nrr::GeneratedScene g = nrr::make_scene(kind);
+    scenes.push_back({name, std::move(g.mesh), g.views.views});
+  }
+  if (wanted.find("dragon_tower") != std::string::npos) {
+    NamedScene d = bench::dragon_tower_scene();
+    if (d.mesh.empty()) std::printf("dragon tower not under %s: skipped\n", bench::shared_datasets_dir().c_str());
+    else scenes.push_back(std::move(d));
+  }
+  if (wanted.find("lucy_like") != std::string::npos) scenes.push_back(bench::lucy_like_scene());
+  return scenes;
 }
 
 std::vector<CameraSpec> sized(std::vector<CameraSpec> views, int res) {
@@ -138,6 +198,68 @@ double bare_embree_ms(const TriMesh& m, const CameraSpec& spec, int repeats, std
   return ms;
 }
 
+/// The NRR variants timed against conventional images, in the library's names.
+const nrr::SamplingMode kTimedModes[] = {nrr::SamplingMode::Conventional, nrr::SamplingMode::NrrPixel,
+                                         nrr::SamplingMode::NrrVisibility, nrr::SamplingMode::NrrVisibilityFrustum};
+
+/// RayScene alone: culled closest hits over view 0's camera rays in 4x4 blocks, nothing stored.
+double trace_only_ms(const nrr::SampledScene& scene, const CameraSpec& view, int repeats) {
+  const Camera camera(view);
+  const int res = view.width;
+  std::vector<mesh::RayF> rays;
+  for (int by = 0; by < res; by += 4)
+    for (int bx = 0; bx < res; bx += 4)
+      for (int y = by; y < std::min(by + 4, res); ++y)
+        for (int x = bx; x < std::min(bx + 4, res); ++x)
+          rays.push_back({Vec3f(view.eye), Vec3f(camera.direction_unit_depth(x + 0.5, y + 0.5))});
+  std::vector<mesh::Hit> hits(rays.size());
+  mesh::QueryOptions cull;
+  cull.cull_back_faces = true;
+  cull.is_coherent = true;
+  return best_ms(repeats, [&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, (rays.size() + 255) / 256), [&](const auto& r) {
+      for (std::size_t b = r.begin(); b < r.end(); ++b) {
+        const std::size_t n = std::min<std::size_t>(256, rays.size() - 256 * b);
+        scene.rays().intersect(Span<const mesh::RayF>(rays.data() + 256 * b, n),
+                               Span<mesh::Hit>(hits.data() + 256 * b, n), cull);
+      }
+    });
+  });
+}
+
+void speed_table(const std::vector<NamedScene>& scenes, int res) {
+  const int repeats = 3;
+  std::printf("Render CPU time (all threads), 3 views at %dx%d, best of %d (ms); ratio = per 3-image set vs "
+              "conventional; Mrays per CPU second on view 0\n", res, res, repeats);
+  std::printf("%-13s", "scene");
+  for (nrr::SamplingMode m : kTimedModes) std::printf(" %14s %6s", nrr::to_string(m).c_str(), "ratio");
+  std::printf(" %10s %10s %10s %6s %6s\n", "conv Mr/s", "trace Mr/s", "bare Mr/s", "conv%", "trace%");
+  for (const NamedScene& s : scenes) {
+    const nrr::SampledScene scene(s.mesh);
+    const auto views = sized(s.views, res);
+    std::printf("%-13s", s.name.c_str());
+    double conv_ms = 0;
+    for (nrr::SamplingMode m : kTimedModes) {
+      nrr::SamplingOptions o;
+      o.mode = m;
+      const double ms = best_ms(repeats, [&] { nrr::render_depth_images(scene, Span<const CameraSpec>(views), o); });
+      if (m == nrr::SamplingMode::Conventional) conv_ms = ms;
+      std::printf(" %14.1f %6.2f", ms, ms / conv_ms);
+    }
+    nrr::SamplingOptions conv;
+    conv.mode = nrr::SamplingMode::Conventional;
+    const double view0_ms =
+        best_ms(repeats, [&] { nrr::render_depth_images(scene, Span<const CameraSpec>(&views[0], 1), conv); });
+    const double trace_ms = trace_only_ms(scene, views[0], repeats);
+    std::size_t bare_hits = 0;
+    const double bare_ms = bare_embree_ms(s.mesh, views[0], repeats, bare_hits);
+    const double rays = double(res) * res;
+    std::printf(" %10.1f %10.1f %10.1f %5.0f%% %5.0f%%\n", rays / view0_ms / 1e3, rays / trace_ms / 1e3,
+                rays / bare_ms / 1e3, 100.0 * bare_ms / view0_ms, 100.0 * bare_ms / trace_ms);
+    std::fflush(stdout);
+  }
+}
+
 struct ModeRow {
   nrr::SamplingMode mode;
   nrr::SamplingMetrics metrics;
@@ -145,152 +267,125 @@ struct ModeRow {
 
 double pct(std::size_t part, std::size_t whole) { return whole ? 100.0 * double(part) / double(whole) : 0.0; }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  const int res = argc > 1 ? std::atoi(argv[1]) : 1024;
-  const int metrics_res = argc > 2 ? std::atoi(argv[2]) : 512;
-  const int n_intermediate = argc > 3 ? std::atoi(argv[3]) : 100;
-  const std::string real_path =
-      argc > 4 ? argv[4] : raysift::bench::shared_dataset("dragon_tower_with_window_holes_49291v_97374tri.obj");
-  const int repeats = 3;
-
-  std::vector<BenchScene> scenes;
-  for (auto kind : {nrr::SceneKind::Grass, nrr::SceneKind::Urban}) {
-    nrr::GeneratedScene g = nrr::make_scene(kind);
-    scenes.push_back({kind == nrr::SceneKind::Grass ? "Grass" : "Urban", std::move(g.mesh), g.views.views});
+/// Metrics of conventional, one NRR variant and peeling images of one scene (Table 1/2 columns).
+std::vector<ModeRow> scene_metrics(const NamedScene& s, nrr::SamplingMode nrr_mode, nrr::Redundancy redundancy,
+                                   int res, int n_frames) {
+  const nrr::SampledScene scene(s.mesh);
+  const auto views = sized(s.views, res);
+  const auto frames = nrr::intermediate_views(Span<const CameraSpec>(views), n_frames);
+  nrr::SamplingOptions conv_o;
+  conv_o.mode = nrr::SamplingMode::Conventional;
+  const auto conv = nrr::render_depth_images(scene, Span<const CameraSpec>(views), conv_o);
+  nrr::MetricsOptions mo;
+  mo.redundancy = redundancy;
+  std::vector<ModeRow> rows;
+  for (nrr::SamplingMode mode : {nrr::SamplingMode::Conventional, nrr_mode, nrr::SamplingMode::Peel}) {
+    nrr::SamplingOptions o;
+    o.mode = mode;
+    const auto images = mode == nrr::SamplingMode::Conventional
+                            ? conv
+                            : nrr::render_depth_images(scene, Span<const CameraSpec>(views), o);
+    rows.push_back({mode, nrr::compute_sampling_metrics(scene, mode, Span<const CameraSpec>(views),
+                                                        Span<const nrr::DepthImage>(images),
+                                                        Span<const nrr::DepthImage>(conv),
+                                                        Span<const CameraSpec>(frames), mo)});
   }
-  {
-    TriMesh real = mesh::read_mesh(real_path);
-    const std::string file = real_path.substr(real_path.find_last_of('/') + 1);
-    std::vector<CameraSpec> views = views_around(real);
-    scenes.push_back({file.substr(0, file.find('_', file.find('_') + 1)), std::move(real), views});
-  }
+  std::printf("  %s: %zu triangles, mean triangle edge / pixel at the scene centre = %.2f\n", s.name.c_str(),
+              s.mesh.triangle_count(), nrr::triangle_pixel_ratio(scene, views[0]));
+  std::fflush(stdout);
+  return rows;
+}
 
-  std::printf("Render CPU time (all threads), 3 views at %dx%d, best of %d (ms); rays/s per CPU second\n", res, res,
-              repeats);
-  std::printf("%-14s %9s %12s %8s %15s %8s %14s %14s %14s %7s %7s\n", "scene", "conv", "nrr-pixel", "ratio",
-              "nrr-visibility", "ratio", "conv Mrays/s", "trace Mrays/s", "bare Mrays/s", "conv%", "trace%");
-  for (const BenchScene& s : scenes) {
-    const nrr::SampledScene scene(s.mesh);
-    const auto views = sized(s.views, res);
-    double ms[3];
-    const nrr::SamplingMode modes[3] = {nrr::SamplingMode::Conventional, nrr::SamplingMode::NrrPixel,
-                                        nrr::SamplingMode::NrrVisibility};
-    for (int k = 0; k < 3; ++k) {
-      nrr::SamplingOptions o;
-      o.mode = modes[k];
-      ms[k] = best_ms(repeats, [&] { nrr::render_depth_images(scene, Span<const CameraSpec>(views), o); });
-    }
-    // The conventional sampler's rate on view 0 alone, against bare Embree on the same camera.
-    nrr::SamplingOptions conv;
-    conv.mode = nrr::SamplingMode::Conventional;
-    const double conv_view0_ms = best_ms(repeats, [&] { nrr::render_depth_images(scene, Span<const CameraSpec>(&views[0], 1), conv); });
-    // The wrapper alone: RayScene culled closest hits over the same camera rays, nothing stored.
-    const Camera camera(views[0]);
-    std::vector<mesh::RayF> camera_rays;
-    for (int by = 0; by < res; by += 4)
-      for (int bx = 0; bx < res; bx += 4)
-        for (int y = by; y < std::min(by + 4, res); ++y)
-          for (int x = bx; x < std::min(bx + 4, res); ++x)
-            camera_rays.push_back({Vec3f(views[0].eye), Vec3f(camera.direction_unit_depth(x + 0.5, y + 0.5))});
-    std::vector<mesh::Hit> hits(camera_rays.size());
-    mesh::QueryOptions cull;
-    cull.cull_back_faces = true;
-    cull.is_coherent = true;
-    const double trace_ms = best_ms(repeats, [&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, (camera_rays.size() + 255) / 256), [&](const auto& r) {
-        for (std::size_t b = r.begin(); b < r.end(); ++b) {
-          const std::size_t n = std::min<std::size_t>(256, camera_rays.size() - 256 * b);
-          scene.rays().intersect(Span<const mesh::RayF>(camera_rays.data() + 256 * b, n),
-                                 Span<mesh::Hit>(hits.data() + 256 * b, n), cull);
-        }
-      });
-    });
-    std::size_t bare_hits = 0;
-    const double bare_ms = bare_embree_ms(s.mesh, views[0], repeats, bare_hits);
-    const double rays = double(res) * res;
-    std::printf("%-14s %9.1f %12.1f %8.2f %15.1f %8.2f %14.1f %14.1f %14.1f %6.0f%% %6.0f%%\n", s.name.c_str(), ms[0],
-                ms[1], ms[1] / ms[0], ms[2], ms[2] / ms[0], rays / conv_view0_ms / 1e3, rays / trace_ms / 1e3,
-                rays / bare_ms / 1e3, 100.0 * bare_ms / conv_view0_ms, 100.0 * bare_ms / trace_ms);
-  }
+std::string cell(const nrr::ImageMetrics& im, int k) {
+  char c[32];
+  if (k == 0) std::snprintf(c, sizeof c, "%.0f", pct(im.redundant, im.samples));
+  else std::snprintf(c, sizeof c, "%.0f (%.0f)", pct(im.disoccluded, im.samples), pct(im.useful, im.disoccluded));
+  return c;
+}
 
-  // Pixel redundancy as in the paper's tables; then Table 2 again with visibility redundancy (the
-  // resolution-independent limit, NRR Fig. 7) at a quarter of the pixels and a fifth of the frames,
-  // because its occlusion rays cost much more.
-  struct Pass {
-    nrr::Redundancy redundancy;
-    int res, frames;
-    std::vector<nrr::SamplingMode> modes;
-  };
-  const Pass passes[2] = {
-      {nrr::Redundancy::Pixel, metrics_res, n_intermediate,
-       {nrr::SamplingMode::Conventional, nrr::SamplingMode::NrrPixel, nrr::SamplingMode::Peel}},
-      {nrr::Redundancy::Visibility, metrics_res / 2, std::max(1, n_intermediate / 5),
-       {nrr::SamplingMode::Conventional, nrr::SamplingMode::NrrVisibility, nrr::SamplingMode::Peel}}};
-  for (const Pass& pass : passes) {
-    const bool is_pixel = pass.redundancy == nrr::Redundancy::Pixel;
-    std::printf("\nSampling metrics, %s redundancy, %dx%d images, %d intermediate frames\n",
-                is_pixel ? "pixel" : "visibility", pass.res, pass.res, pass.frames);
-    std::vector<std::vector<ModeRow>> rows(scenes.size());
+std::string paper_cell(const PaperCell& p) {
+  char c[32];
+  if (p.useful_pct < 0) std::snprintf(c, sizeof c, "[%d]", p.pct);
+  else std::snprintf(c, sizeof c, "[%d (%d)]", p.pct, p.useful_pct);
+  return c;
+}
+
+void print_table1(const std::vector<NamedScene>& scenes, const std::vector<std::vector<ModeRow>>& rows) {
+  std::printf("\nTable 1  View-independent sampling metrics, ours [paper] (%% of the image's samples; useful in %% "
+              "of disoccluded)\n%-13s %24s %24s %24s\n", "Model", "Image 0 (%)", "Image 1 (%)", "Image 2 (%)");
+  const char* titles[3] = {"Redundant samples for conventional sampling",
+                           "Disoccluded and (useful) samples for non-redundant rendering",
+                           "Disoccluded and (useful) samples for depth peeling"};
+  for (int k = 0; k < 3; ++k) {
+    std::printf("%s\n", titles[k]);
     for (std::size_t si = 0; si < scenes.size(); ++si) {
-      const nrr::SampledScene scene(scenes[si].mesh);
-      const auto views = sized(scenes[si].views, pass.res);
-      const auto frames = nrr::intermediate_views(Span<const CameraSpec>(views), pass.frames);
-      nrr::SamplingOptions conv_o;
-      conv_o.mode = nrr::SamplingMode::Conventional;
-      const auto conv = nrr::render_depth_images(scene, Span<const CameraSpec>(views), conv_o);
-      nrr::MetricsOptions mo;
-      mo.redundancy = pass.redundancy;
-      for (nrr::SamplingMode mode : pass.modes) {
-        nrr::SamplingOptions o;
-        o.mode = mode;
-        const auto images = mode == nrr::SamplingMode::Conventional
-                                ? conv
-                                : nrr::render_depth_images(scene, Span<const CameraSpec>(views), o);
-        rows[si].push_back({mode, nrr::compute_sampling_metrics(scene, mode, Span<const CameraSpec>(views),
-                                                                Span<const nrr::DepthImage>(images),
-                                                                Span<const nrr::DepthImage>(conv),
-                                                                Span<const CameraSpec>(frames), mo)});
+      const PaperModel* p = paper_model(scenes[si].name);
+      std::printf("%-13s", scenes[si].name.c_str());
+      const auto& images = rows[si][std::size_t(k)].metrics.images;
+      for (std::size_t i = 0; i < images.size(); ++i) {
+        const PaperCell* pc = !p ? nullptr : k == 0 ? &p->redundant_conv[i] : k == 1 ? &p->nrr[i] : &p->peel[i];
+        std::printf(" %24s", (cell(images[i], k) + " " + (pc ? paper_cell(*pc) : std::string("[-]"))).c_str());
       }
-      std::printf("  %s: mean triangle edge / pixel size at the scene centre = %.2f\n", scenes[si].name.c_str(),
-                  scene.mean_edge_length() /
-                      (2.0 * length(scene.rays().bounds().center() - views[0].eye) *
-                       std::tan(views[0].fov_y_deg * M_PI / 360.0) / pass.res));
-    }
-    if (is_pixel) {
-      std::printf("\nTable 1  View-independent sampling metrics (%% of the image's samples; useful in %% of "
-                  "disoccluded)\n");
-      std::printf("%-14s %16s %16s %16s\n", "Model", "Image 0 (%)", "Image 1 (%)", "Image 2 (%)");
-      const char* titles[3] = {"Redundant samples for conventional sampling",
-                               "Disoccluded and (useful) samples for non-redundant rendering",
-                               "Disoccluded and (useful) samples for depth peeling"};
-      for (int k = 0; k < 3; ++k) {
-        std::printf("%s\n", titles[k]);
-        for (std::size_t si = 0; si < scenes.size(); ++si) {
-          std::printf("%-14s", scenes[si].name.c_str());
-          for (const nrr::ImageMetrics& im : rows[si][std::size_t(k)].metrics.images) {
-            char cell[32];
-            if (k == 0)
-              std::snprintf(cell, sizeof cell, "%.0f", pct(im.redundant, im.samples));
-            else
-              std::snprintf(cell, sizeof cell, "%.0f (%.0f)", pct(im.disoccluded, im.samples),
-                            pct(im.useful, im.disoccluded));
-            std::printf(" %16s", cell);
-          }
-          std::printf("\n");
-        }
-      }
-    }
-    std::printf("\nTable 2  View-dependent sampling metric, %s redundancy (%% of intermediate-frame samples "
-                "available)\n", is_pixel ? "pixel" : "visibility");
-    std::printf("%-14s %10s %10s %10s %10s %10s %10s\n", "Model", "Conv avg", "Conv min", "NRR avg", "NRR min",
-                "Peel avg", "Peel min");
-    for (std::size_t si = 0; si < scenes.size(); ++si) {
-      std::printf("%-14s", scenes[si].name.c_str());
-      for (const ModeRow& r : rows[si]) std::printf(" %10.1f %10.1f", r.metrics.available_avg_pct, r.metrics.available_min_pct);
       std::printf("\n");
     }
   }
+}
+
+void print_table2(const std::vector<NamedScene>& scenes, const std::vector<std::vector<ModeRow>>& rows,
+                  bool with_paper) {
+  std::printf("%-13s %16s %16s %16s %16s %16s %16s\n", "Model", "Conv avg", "Conv min", "NRR avg", "NRR min",
+              "Peel avg", "Peel min");
+  for (std::size_t si = 0; si < scenes.size(); ++si) {
+    const PaperModel* p = with_paper ? paper_model(scenes[si].name) : nullptr;
+    std::printf("%-13s", scenes[si].name.c_str());
+    for (std::size_t m = 0; m < rows[si].size(); ++m)
+      for (int k = 0; k < 2; ++k) {
+        const nrr::SamplingMetrics& r = rows[si][m].metrics;
+        char c[40];
+        std::snprintf(c, sizeof c, "%.1f [%s]", k == 0 ? r.available_avg_pct : r.available_min_pct,
+                      p ? std::to_string(p->available[m][k]).c_str() : "-");
+        std::printf(" %16s", c);
+      }
+    std::printf("\n");
+  }
+}
+
+void metrics_tables(const std::vector<NamedScene>& scenes, const Args& a) {
+  const bool is_paper = a.metrics_res == kPaperResolution && a.frames == kPaperFrames;
+  std::printf("\nSampling metrics in the paper's configuration: pixel redundancy, nrr-pixel images, %dx%d, %d "
+              "intermediate frames (%s)\n", a.metrics_res, a.metrics_res, a.frames,
+              is_paper ? "the paper's setting" : "COARSER than the paper's 1024x1024 with 1000 frames");
+  std::vector<std::vector<ModeRow>> rows;
+  for (const NamedScene& s : scenes)
+    rows.push_back(scene_metrics(s, nrr::SamplingMode::NrrPixel, nrr::Redundancy::Pixel, a.metrics_res, a.frames));
+  print_table1(scenes, rows);
+  std::printf("\nTable 2  View-dependent sampling metric, pixel redundancy, ours [paper] (%% of intermediate-frame "
+              "samples available)\n");
+  print_table2(scenes, rows, true);
+  if (a.vis_res == 0) return;
+  // Not in the paper: the resolution-independent limit (Fig. 7), nrr-visibility images and visibility metrics.
+  std::printf("\nTable 2 with visibility redundancy (nrr-visibility images; not in the paper), %dx%d, %d frames\n",
+              a.vis_res, a.vis_res, a.vis_frames);
+  std::vector<std::vector<ModeRow>> vis_rows;
+  for (const NamedScene& s : scenes)
+    vis_rows.push_back(
+        scene_metrics(s, nrr::SamplingMode::NrrVisibility, nrr::Redundancy::Visibility, a.vis_res, a.vis_frames));
+  print_table2(scenes, vis_rows, false);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Args a;
+  if (!parse_args(argc, argv, a)) {
+    std::fprintf(stderr, "usage: nrr_bench [--res 1024] [--metrics-res 1024] [--frames 1000] [--vis-res 256] "
+                         "[--vis-frames 20] [--scenes grass,urban,dragon_tower,lucy_like] [--no-metrics]\n");
+    return 2;
+  }
+  const std::vector<NamedScene> scenes = load_scenes(a.scenes);
+  Timer total;
+  speed_table(scenes, a.res);
+  if (a.with_metrics) metrics_tables(scenes, a);
+  std::printf("\nnrr_bench: %.0f s wall\n", total.elapsed_ms() / 1000.0);
   return 0;
 }
