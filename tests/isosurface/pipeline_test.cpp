@@ -23,6 +23,13 @@ volume::Volume shells() {
   return volume::make_shells(o);
 }
 
+volume::Volume ball(double radius_voxels) {
+  volume::BallOptions b;
+  b.grid.dims = {64, 64, 64};
+  b.radius_voxels = radius_voxels;
+  return volume::make_ball(b);
+}
+
 PipelineOptions no_prep() {
   PipelineOptions o;
   o.prep.smooth_before.iterations = o.prep.smooth_after.iterations = 0;
@@ -31,12 +38,9 @@ PipelineOptions no_prep() {
 }
 
 TEST(Pipeline, SphereAreaAndVolumeWithinOnePercentWithoutPreparation) {
-  volume::BallOptions b;
-  b.grid.dims = {64, 64, 64};
-  b.radius_voxels = 24;
   PipelineOptions o = no_prep();
   o.iso_values = {0.5};
-  const IsosurfaceSet set = build_isosurfaces(volume::make_ball(b), nullptr, o);
+  const IsosurfaceSet set = build_isosurfaces(ball(24), nullptr, o);
   ASSERT_EQ(set.surfaces.size(), 1u);
   const mesh::MeshAnalysis a = mesh::analyze_mesh(set.surfaces[0].mesh);
   EXPECT_TRUE(a.is_closed_manifold());
@@ -48,21 +52,18 @@ TEST(Pipeline, SphereAreaAndVolumeWithinOnePercentWithoutPreparation) {
 }
 
 TEST(Pipeline, DecimationThatWouldExceedTheMemoryLimitFailsBeforeItStarts) {
-  volume::BallOptions b;
-  b.grid.dims = {64, 64, 64};
-  b.radius_voxels = 24;
   PipelineOptions o = no_prep();
   o.iso_values = {0.5};
-  const TriMesh mesh = build_isosurfaces(volume::make_ball(b), nullptr, o).surfaces.at(0).mesh;
+  const volume::Volume sphere = ball(24);
+  const TriMesh mesh = build_isosurfaces(sphere, nullptr, o).surfaces.at(0).mesh;
   const std::uint64_t mesh_bytes = mesh.positions.size() * sizeof(Vec3f) + mesh.triangles.size() * 12;
   // Room for marching cubes and its mesh, not for the decimater's ~140 bytes per triangle.
   const MemoryLimit limit{3 * mesh_bytes, true};
   o.marching_cubes.memory_limit = &limit;
-  EXPECT_EQ(build_isosurfaces(volume::make_ball(b), nullptr, o).surfaces.at(0).mesh.triangle_count(),
-            mesh.triangle_count());
+  EXPECT_EQ(build_isosurfaces(sphere, nullptr, o).surfaces.at(0).mesh.triangle_count(), mesh.triangle_count());
   o.prep.decimation.ratio = 0.5;
   try {
-    build_isosurfaces(volume::make_ball(b), nullptr, o);
+    build_isosurfaces(sphere, nullptr, o);
     FAIL() << "expected ResourceError";
   } catch (const ResourceError& e) {
     EXPECT_NE(std::string(e.what()).find("smoothing and decimating " + std::to_string(mesh.triangle_count()) +
