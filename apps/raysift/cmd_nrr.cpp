@@ -20,7 +20,8 @@ namespace raysift::app {
 namespace {
 
 struct NrrCliOptions {
-  std::string mesh, out_dir, views_file, eyes;
+  std::string mesh, out_dir, views_file;
+  std::vector<std::string> eyes;  ///< "x,y,z" each (checked by CLI11)
   std::string region;
   std::vector<double> target, up{0, 1, 0};
   double fov_y_deg = 45.0;
@@ -38,22 +39,6 @@ const std::map<std::string, nrr::Redundancy> kRedundancies = {{"pixel", nrr::Red
 
 Vec3d vec3(const std::vector<double>& v) { return {v[0], v[1], v[2]}; }
 
-/// "x,y,z;x,y,z[;...]" -> eyes; exit 2 naming --eyes for a malformed entry.
-std::vector<Vec3d> parse_eyes(const std::string& text) {
-  std::vector<Vec3d> eyes;
-  std::stringstream items(text);
-  std::string item;
-  while (std::getline(items, item, ';')) {
-    std::istringstream in(item);
-    Vec3d v;
-    char c1 = 0, c2 = 0;
-    if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || !(in >> std::ws).eof() || !is_finite(v))
-      bad_flag("--eyes", "three finite numbers x,y,z per eye", "'" + item + "'");
-    eyes.push_back(v);
-  }
-  return eyes;
-}
-
 nrr::ViewSet views_from_options(const NrrCliOptions& o) {
   if (o.views_file.empty() == o.region.empty())
     throw UsageError("give exactly one of --views FILE and --view-region segment|triangle|rectangle; see --help");
@@ -64,7 +49,8 @@ nrr::ViewSet views_from_options(const NrrCliOptions& o) {
     const nrr::ViewRegion region = nrr::parse_view_region(o.region);  // checked by CLI11
     if (o.eyes.empty() || o.target.empty())
       throw UsageError("--view-region needs --eyes \"x,y,z;x,y,z...\" and --target x,y,z; see --help");
-    const std::vector<Vec3d> eyes = parse_eyes(o.eyes);
+    std::vector<Vec3d> eyes;
+    for (const std::string& e : o.eyes) eyes.push_back(*parse_vec3(e));
     if (int(eyes.size()) != nrr::corner_count(region))
       bad_flag("--eyes", std::to_string(nrr::corner_count(region)) + " eyes for a " + o.region,
                std::to_string(eyes.size()) + " eyes");
@@ -91,7 +77,8 @@ void add_options(CLI::App& sub, NrrCliOptions& o) {
                     "views JSON: a list of cameras, or {\"views\": [...], \"intermediate_views\": [...]}");
   views->add_option("--view-region", o.region, "eyes' region (with --eyes, --target)")
       ->check(CLI::IsMember({"segment", "triangle", "rectangle"}));
-  views->add_option("--eyes", o.eyes, "corner eyes \"x,y,z;x,y,z[;...]\" (2, 3 or 4, rectangle in perimeter order)");
+  views->add_option("--eyes", o.eyes, "corner eyes \"x,y,z;x,y,z[;...]\" (2, 3 or 4, rectangle in perimeter order)")
+      ->delimiter(';')->check(vec3_text());
   views->add_option("--target", o.target, "common look-at point x,y,z for --view-region")->delimiter(',')->expected(3)
       ->check(number_in(-INFINITY, INFINITY));
   views->add_option("--up", o.up, "common up vector for --view-region")->delimiter(',')->expected(3)
