@@ -1,6 +1,7 @@
 #include "core/file_util.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -48,6 +49,15 @@ void write_atomically(const std::string& path, const std::function<void(const st
     fs::remove(tmp, ec);
     throw;
   }
+}
+
+void write_text_file(const std::string& path, const std::string& text) {
+  write_atomically(path, [&](const std::string& tmp) {
+    std::FILE* f = std::fopen(tmp.c_str(), "wb");
+    if (!f) throw IoError(file_message(path, "cannot open for writing"));
+    const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+    if (std::fclose(f) != 0 || !ok) throw IoError(file_message(path, "write failed"));
+  });
 }
 
 }  // namespace raysift

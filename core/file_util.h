@@ -12,6 +12,9 @@ namespace raysift {
 /// \throw Cancelled if a SIGINT/SIGTERM arrived before the rename (core/signals.h); IoError if `path` is a directory, its parent folder does not exist, or the rename fails.
 void write_atomically(const std::string& path, const std::function<void(const std::string& tmp_path)>& write);
 
+/// Writes `text` to `path` atomically (write_atomically). \throw IoError naming the file, or as write_atomically.
+void write_text_file(const std::string& path, const std::string& text);
+
 /// \throw IoError naming the file if it is missing, a directory or unreadable.
 void require_readable_file(const std::string& path);
 

@@ -27,13 +27,7 @@ Json read_json_file(const std::string& path) {
 }
 
 void write_json_file(const std::string& path, const Json& json) {
-  write_atomically(path, [&](const std::string& tmp) {
-    std::FILE* f = std::fopen(tmp.c_str(), "wb");
-    if (!f) throw IoError(file_message(path, "cannot open for writing"));
-    const std::string text = json.dump(2) + "\n";
-    const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-    if (std::fclose(f) != 0 || !ok) throw IoError(file_message(path, "write failed"));
-  });
+  write_text_file(path, json.dump(2) + "\n");
 }
 
 Vec3d vec3_from_json(const Json& j, const std::string& where) {

@@ -1,13 +1,11 @@
 #include "features/lines.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/parallel.h"
 
 namespace raysift::features {
 namespace {
@@ -55,13 +53,7 @@ PerView compute_per_view(const TriMesh& mesh, const mesh::MeshCurvature& c, cons
     if (need_sc) pv.sc_num[i] = float(nsc - sc_thresh * ndotv);
     if (need_sh) pv.sh_num[i] = float(-nsc - sh_thresh * ndotv);
   };
-  if (o.threaded) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
-    });
-  } else {
-    for (std::size_t i = 0; i < nv; ++i) body(i);
-  }
+  parallel_for_each(nv, body, o.threaded, std::size_t(2048));
   return pv;
 }
 
@@ -282,13 +274,7 @@ FeatureLines extract_lines(const TriMesh& mesh, const mesh::MeshCurvature& curva
       if (do_valleys) face_ridges(ctx, curvature, t, false, rv_thresh);
     }
   };
-  if (options.threaded) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t ci = r.begin(); ci != r.end(); ++ci) run_chunk(ci);
-    });
-  } else {
-    for (std::size_t ci = 0; ci < chunks; ++ci) run_chunk(ci);
-  }
+  parallel_for_each(chunks, run_chunk, options.threaded);
   std::size_t total = 0;
   for (const auto& p : parts) total += p.size();
   lines.segments.reserve(total);

@@ -1,13 +1,11 @@
 #include "features/visibility.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <string>
 
 #include "core/errors.h"
+#include "core/parallel.h"
 
 namespace raysift::features {
 namespace {
@@ -108,13 +106,7 @@ FeatureLines remove_hidden_lines(const FeatureLines& lines, const DepthBuffer& d
     for (std::size_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i)
       clip_segment(lines.segments[i], camera, sampler, o, parts[c]);
   };
-  if (o.threaded) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t c = r.begin(); c != r.end(); ++c) run(c);
-    });
-  } else {
-    for (std::size_t c = 0; c < chunks; ++c) run(c);
-  }
+  parallel_for_each(chunks, run, o.threaded);
   FeatureLines visible;
   for (const auto& p : parts) visible.segments.insert(visible.segments.end(), p.begin(), p.end());
   return visible;

@@ -50,10 +50,8 @@ std::vector<std::pair<int, int>> disc_offsets(double radius) {
   return offsets;
 }
 
-}  // namespace
-
-WarpResult warp_map(const ImageF& map, const ImageF& depth_ray, const Camera& previous, const Camera& current,
-                    const WarpOptions& options) {
+/// \throw InvalidInput as warp_map documents.
+void validate_warp_inputs(const ImageF& map, const ImageF& depth_ray, const WarpOptions& options) {
   std::ostringstream why;
   if (map.width <= 0 || map.height <= 0 || map.size() != std::size_t(map.width) * std::size_t(map.height)) {
     why << "warp: the map is empty (" << map.width << "x" << map.height << " pixels)";
@@ -75,14 +73,18 @@ WarpResult warp_map(const ImageF& map, const ImageF& depth_ray, const Camera& pr
         << ") is not finite";
     throw InvalidInput(why.str());
   }
+}
 
-  const int w = map.width, h = map.height;
-  const std::size_t n = map.size();
-  const bool threaded = options.threaded;
+using Winners = std::unique_ptr<std::atomic<std::uint64_t>[]>;
+
+/// Per map pixel of the current view, the packed (view depth, source index) of the nearest source that lands
+/// there, or kEmpty.
+Winners splat(const ImageF& depth_ray, const Camera& previous, const Camera& current, bool threaded) {
+  const int w = depth_ray.width, h = depth_ray.height;
+  const std::size_t n = depth_ray.size();
   const double prev_sx = double(previous.width()) / w, prev_sy = double(previous.height()) / h;
   const double cur_sx = double(w) / current.width(), cur_sy = double(h) / current.height();
-
-  std::unique_ptr<std::atomic<std::uint64_t>[]> winner(new std::atomic<std::uint64_t>[n]);
+  Winners winner(new std::atomic<std::uint64_t>[n]);
   for (std::size_t i = 0; i < n; ++i) winner[i].store(kEmpty, std::memory_order_relaxed);
   parallel_rows(h, [&](int y) {
     for (int x = 0; x < w; ++x) {
@@ -99,9 +101,20 @@ WarpResult warp_map(const ImageF& map, const ImageF& depth_ray, const Camera& pr
       atomic_min(winner[dst], pack(float(p->depth), std::uint32_t(src)));
     }
   }, threaded);
+  return winner;
+}
 
+}  // namespace
+
+WarpResult warp_map(const ImageF& map, const ImageF& depth_ray, const Camera& previous, const Camera& current,
+                    const WarpOptions& options) {
+  validate_warp_inputs(map, depth_ray, options);
+  const int w = map.width, h = map.height;
+  const Winners winner = splat(depth_ray, previous, current, options.threaded);
+
+  // Splatted pixels take their winner's value; empty ones the nearest splatted neighbour's, else disocclusion.
   enum Origin : std::uint8_t { kSplatted, kHoleClosed, kDisoccluded };
-  std::vector<std::uint8_t> origin(n);
+  std::vector<std::uint8_t> origin(map.size());
   WarpResult result;
   result.map = ImageF(w, h);
   const auto offsets = disc_offsets(options.hole_radius_px);
@@ -130,7 +143,7 @@ WarpResult warp_map(const ImageF& map, const ImageF& depth_ray, const Camera& pr
         }
       }
     }
-  }, threaded);
+  }, options.threaded);
   for (std::uint8_t o : origin) ++(o == kSplatted ? result.n_splatted : o == kHoleClosed ? result.n_hole_closed
                                                                                          : result.n_disoccluded);
   return result;

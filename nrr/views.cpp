@@ -92,21 +92,6 @@ void write_views_file(const std::string& path, const ViewSet& views) {
   write_json_file(path, j);
 }
 
-std::vector<Vec3d> parse_eye_list(const std::string& text) {
-  std::vector<Vec3d> eyes;
-  std::stringstream items(text);
-  std::string item;
-  while (std::getline(items, item, ';')) {
-    std::istringstream in(item);
-    Vec3d v;
-    char c1 = 0, c2 = 0;
-    if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || !(in >> std::ws).eof() || !is_finite(v))
-      throw InvalidInput("'" + item + "'");
-    eyes.push_back(v);
-  }
-  return eyes;
-}
-
 std::vector<CameraSpec> region_views(ViewRegion region, Span<const Vec3d> eyes, const CameraSpec& common) {
   if (int(eyes.size()) != corner_count(region))
     throw InvalidInput("a " + std::string(region == ViewRegion::Segment    ? "segment"

@@ -30,10 +30,6 @@ ViewSet read_views_file(const std::string& path);
 /// Writes the object form. \throw IoError.
 void write_views_file(const std::string& path, const ViewSet& views);
 
-/// "x,y,z;x,y,z[;...]" -> eyes. \throw InvalidInput quoting the first entry that is not three finite
-/// numbers separated by commas.
-std::vector<Vec3d> parse_eye_list(const std::string& text);
-
 /// One view per corner eye, all sharing `common`'s target, up, field of view and size.
 /// \throw InvalidInput if eyes.size() != corner_count(region) or a resulting camera is invalid.
 std::vector<CameraSpec> region_views(ViewRegion region, Span<const Vec3d> eyes, const CameraSpec& common);

@@ -293,106 +293,131 @@ ImageF path_frame_importance(const volume::RayCaster& caster, const FeatureGeome
   return importance;
 }
 
+namespace {
+
+/// The target-fps controller of a path; none without a target. \throw InvalidInput as render_camera_path.
+std::optional<FrameRateController> make_controller(const PathRenderOptions& options) {
+  if (options.target_fps == 0) return std::nullopt;
+  const SamplingMode mode = options.sampling.mode;
+  if (mode != SamplingMode::Prioritized)
+    throw InvalidInput("a target frame rate needs the prioritized mode, got " + std::string(sampling_mode_name(mode)));
+  if (options.sampling.budget_ms > 0)
+    throw InvalidInput("a target frame rate adapts alpha00 and cannot be combined with a per-frame time budget; give one");
+  FrameRateOptions fo;
+  fo.target_fps = options.target_fps;
+  fo.threshold = std::isfinite(options.sampling.threshold) ? options.sampling.threshold : fo.threshold;
+  fo.initial_alpha00 = options.sampling.mapping.alpha[0];
+  return FrameRateController(fo);  // validates target_fps
+}
+
+/// What a path carries from frame to frame.
+struct PathState {
+  const PathRenderOptions& options;
+  std::optional<FrameRateController> controller;
+  std::vector<PathFrame> frames;
+  std::optional<PreviousFrame> previous;
+  std::unique_ptr<RayCache> cache;
+  std::unique_ptr<FractalPattern> pattern;
+  ImageF still_importance;  // importance of the first frame since the camera stopped
+  float alpha00;
+  int still_frames = 0;     // frames since the camera stopped, after the first
+  FrameTiming last_timing;
+
+  explicit PathState(const PathRenderOptions& o)
+      : options(o), controller(make_controller(o)), alpha00(o.sampling.mapping.alpha[0]) {}
+};
+
+/// A full frame: rendered once per camera; a still camera has nothing left to refine.
+ImageRGBA full_frame(const volume::RayCaster& caster, PathState& st, PathFrame& frame, const Timer& clock) {
+  frame.full_rays = std::size_t(caster.width()) * std::size_t(caster.height());
+  if (frame.refined) return st.previous->image;
+  volume::RenderResult r = volume::render_full(caster);
+  frame.rays_traced = std::size_t(r.rays_traced);
+  frame.trace_ms = clock.elapsed_ms();
+  st.cache = std::make_unique<RayCache>(caster.width(), caster.height());
+  st.cache->depth = std::move(r.depth);
+  return std::move(r.image);
+}
+
+/// A prioritized frame's selection: α00 from the controller, or, for a still camera, a superset of the frame
+/// before (a threshold frame raises α00, a fraction frame adds another fraction).
+SamplingOptions prioritized_options(PathState& st, const PathFrame& frame) {
+  SamplingOptions so = st.options.sampling;
+  if (st.controller) {
+    if (!st.frames.empty())
+      st.alpha00 = st.controller->update(
+          st.last_timing, RayCountCurve(st.still_importance, *st.pattern, so.mapping, st.controller->threshold()),
+          frame.refined ? st.cache->traced : 0);
+    if (frame.refined) st.alpha00 = std::max(st.alpha00, st.frames.back().alpha00);
+    so.threshold = st.controller->threshold();
+    so.mapping.alpha[0] = st.alpha00;
+  } else if (frame.refined) {
+    if (std::isfinite(so.threshold))
+      so.mapping.alpha[0] = st.alpha00 = st.frames.back().alpha00 + kRefineStep;
+    else
+      so.ray_fraction = std::min(1.0, so.ray_fraction * double(st.still_frames + 1));
+  }
+  return so;
+}
+
+/// A prioritized or subsampled frame; a new camera gets a new ray cache and importance.
+ImageRGBA sampled_frame(const volume::RayCaster& caster, const FeatureGeometry* geometry, PathState& st,
+                        PathFrame& frame, const Timer& clock) {
+  const PathRenderOptions& options = st.options;
+  const int w = caster.width(), h = caster.height();
+  if (!frame.refined) {
+    st.cache = std::make_unique<RayCache>(w, h);
+    if (!st.pattern || st.pattern->level.width != w || st.pattern->level.height != h)
+      st.pattern = std::make_unique<FractalPattern>(make_fractal_pattern(w, h, options.sampling.base_spacing));
+    st.still_importance = path_frame_importance(caster, geometry, options.features, st.previous ? &*st.previous : nullptr,
+                                                options.sampling.base_spacing, &frame.saliency_ms);
+    frame.importance_ms = clock.elapsed_ms();
+  }
+  SamplingOptions so = options.sampling;
+  if (so.mode == SamplingMode::Prioritized) {
+    so = prioritized_options(st, frame);
+    frame.alpha00 = so.mapping.alpha[0];
+  }
+  std::atomic<std::size_t> new_rays{0};
+  const SampledFrame s =
+      render_sampled(st.still_importance, cached_trace(caster, *st.cache, new_rays), so, clock.elapsed_ms());
+  st.cache->traced += new_rays;
+  frame.rays_traced = new_rays;
+  frame.full_rays = s.full_rays;
+  frame.trace_ms = s.trace_ms;
+  st.last_timing = {0, s.trace_ms, new_rays};
+  return composite_frame(s.image, caster.options().background);
+}
+
+}  // namespace
+
 std::vector<PathFrame> render_camera_path(const volume::Volume& volume, const volume::TransferFunction& tf,
                                           const volume::RenderOptions& render, const std::vector<CameraSpec>& cameras,
                                           const FeatureGeometry* geometry, const PathRenderOptions& options,
                                           const PathFrameSink& sink) {
   if (cameras.empty()) throw InvalidInput("camera path: no cameras (0 frames)");
   validate(options.sampling);
-  const SamplingMode mode = options.sampling.mode;
-  std::optional<FrameRateController> controller;
-  if (options.target_fps != 0) {
-    if (mode != SamplingMode::Prioritized)
-      throw InvalidInput("a target frame rate needs the prioritized mode, got " + std::string(sampling_mode_name(mode)));
-    if (options.sampling.budget_ms > 0)
-      throw InvalidInput("a target frame rate adapts alpha00 and cannot be combined with a per-frame time budget; give one");
-    FrameRateOptions fo;
-    fo.target_fps = options.target_fps;
-    fo.threshold = std::isfinite(options.sampling.threshold) ? options.sampling.threshold : fo.threshold;
-    fo.initial_alpha00 = options.sampling.mapping.alpha[0];
-    controller.emplace(fo);  // validates target_fps
-  }
-
-  std::vector<PathFrame> frames;
-  std::optional<PreviousFrame> previous;
-  std::unique_ptr<RayCache> cache;
-  std::unique_ptr<FractalPattern> pattern;
-  ImageF still_importance;  // importance of the first frame since the camera stopped
-  float alpha00 = options.sampling.mapping.alpha[0];
-  int still_frames = 0;  // frames since the camera stopped, after the first
-  FrameTiming last_timing;
+  PathState st(options);
   const auto bricks = volume::build_volume_bricks(volume);  // view-independent: once per path
   for (std::size_t i = 0; i < cameras.size(); ++i) {
     const CameraSpec& spec = cameras[i];
     // Building the caster stands in for an interactive camera update; it is not part of the frame time.
     const volume::RayCaster caster(volume, bricks, tf, spec, render);
-    const int w = caster.width(), h = caster.height();
     PathFrame frame;
     frame.index = int(i);
-    frame.refined = previous.has_value() && same_camera(previous->camera, spec);
-    still_frames = frame.refined ? still_frames + 1 : 0;
-    ImageRGBA image;
+    frame.refined = st.previous.has_value() && same_camera(st.previous->camera, spec);
+    st.still_frames = frame.refined ? st.still_frames + 1 : 0;
     const Timer clock;
-    if (mode == SamplingMode::Full) {
-      if (frame.refined) {
-        image = previous->image;  // nothing left to refine: the frame is already complete
-      } else {
-        volume::RenderResult r = volume::render_full(caster);
-        image = std::move(r.image);
-        frame.rays_traced = std::size_t(r.rays_traced);
-        frame.trace_ms = clock.elapsed_ms();
-        cache = std::make_unique<RayCache>(w, h);
-        cache->depth = std::move(r.depth);
-      }
-      frame.full_rays = std::size_t(w) * std::size_t(h);
-    } else {
-      if (!frame.refined) {
-        cache = std::make_unique<RayCache>(w, h);
-        if (!pattern || pattern->level.width != w || pattern->level.height != h)
-          pattern = std::make_unique<FractalPattern>(make_fractal_pattern(w, h, options.sampling.base_spacing));
-        still_importance = path_frame_importance(caster, geometry, options.features,
-                                                 previous ? &*previous : nullptr, options.sampling.base_spacing,
-                                                 &frame.saliency_ms);
-        frame.importance_ms = clock.elapsed_ms();
-      }
-      SamplingOptions so = options.sampling;
-      if (mode == SamplingMode::Prioritized) {
-        if (controller) {
-          if (!frames.empty())
-            alpha00 = controller->update(last_timing,
-                                         RayCountCurve(still_importance, *pattern, so.mapping, controller->threshold()),
-                                         frame.refined ? cache->traced : 0);
-          if (frame.refined) alpha00 = std::max(alpha00, frames.back().alpha00);
-          so.threshold = controller->threshold();
-          so.mapping.alpha[0] = alpha00;
-        } else if (frame.refined) {
-          // Refinement keeps the frame's own selection rule, so every still frame selects a superset of
-          // the one before: a threshold frame raises α00, a fraction frame adds another fraction.
-          if (std::isfinite(so.threshold))
-            so.mapping.alpha[0] = alpha00 = frames.back().alpha00 + kRefineStep;
-          else
-            so.ray_fraction = std::min(1.0, so.ray_fraction * double(still_frames + 1));
-        }
-        frame.alpha00 = so.mapping.alpha[0];
-      }
-      std::atomic<std::size_t> new_rays{0};
-      const SampledFrame s =
-          render_sampled(still_importance, cached_trace(caster, *cache, new_rays), so, clock.elapsed_ms());
-      cache->traced += new_rays;
-      frame.rays_traced = new_rays;
-      frame.full_rays = s.full_rays;
-      frame.trace_ms = s.trace_ms;
-      image = composite_frame(s.image, caster.options().background);
-      last_timing = {0, s.trace_ms, new_rays};
-    }
+    ImageRGBA image = options.sampling.mode == SamplingMode::Full ? full_frame(caster, st, frame, clock)
+                                                                  : sampled_frame(caster, geometry, st, frame, clock);
     frame.ms = clock.elapsed_ms();
-    last_timing.frame_ms = frame.ms;
+    st.last_timing.frame_ms = frame.ms;
     if (options.compare_full) frame.ssim_vs_full = mean_ssim(volume::render_full(caster).image, image);
     sink(frame, image);
-    frames.push_back(frame);
-    previous = PreviousFrame{spec, std::move(image), cache->depth};
+    st.frames.push_back(frame);
+    st.previous = PreviousFrame{spec, std::move(image), st.cache->depth};
   }
-  return frames;
+  return std::move(st.frames);
 }
 
 namespace {
@@ -416,12 +441,10 @@ PathRenderResult run_path_request(const volume::Volume& volume, const volume::Tr
   const std::vector<CameraSpec> cameras = load_camera_path(request.camera_path, camera);
   const Timer setup;
   std::optional<FeatureGeometry> geometry;
-  if (!request.options.features.lines.classes.is_empty() && request.feature_mesh.empty()) {
-    FeatureGeometryOptions options = request.geometry;
-    if (!options.view) options.view = finest_view(volume, cameras, request.options.features.lines.importance.scale);
-    geometry = build_feature_geometry(volume, tf, options, request.feature_cache);
-  } else if (!request.options.features.lines.classes.is_empty()) {
-    geometry = load_feature_geometry(request.feature_mesh, &volume);
+  if (!request.options.features.lines.classes.is_empty()) {
+    const double scale = request.options.features.lines.importance.scale;
+    geometry = feature_geometry_for(volume, tf, finest_view(volume, cameras, scale), request.geometry,
+                                    request.feature_mesh, request.feature_cache);
   }
   PathRenderResult out;
   out.features_setup_ms = setup.elapsed_ms();

@@ -1,13 +1,11 @@
 #include "sampling/fractal_pattern.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <mutex>
 #include <string>
 
 #include "core/camera.h"
 #include "core/errors.h"
+#include "core/parallel.h"
 
 namespace raysift::sampling {
 namespace {
@@ -38,9 +36,8 @@ FractalPattern make_fractal_pattern(int width, int height, int base_spacing) {
   pattern.base_spacing = base_spacing;
   pattern.num_levels = 1 + 2 * log2_exact(base_spacing);
   pattern.level = Image<std::uint8_t>(width, height, 0);
-  tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
-    for (int y = rows.begin(); y < rows.end(); ++y)
-      for (int x = 0; x < width; ++x) pattern.level(x, y) = std::uint8_t(fractal_level(x, y, base_spacing));
+  parallel_rows(height, [&](int y) {
+    for (int x = 0; x < width; ++x) pattern.level(x, y) = std::uint8_t(fractal_level(x, y, base_spacing));
   });
   std::lock_guard<std::mutex> lock(mutex);
   last = pattern;

@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "core/colour.h"
@@ -39,6 +40,23 @@ void require_finite(const ImageRGBA& image, const char* which) {
 
 std::array<float, 3> display_rgb(const Rgba& p) {
   return {linear_to_srgb(p.r), linear_to_srgb(p.g), linear_to_srgb(p.b)};
+}
+
+/// Sum of term(a_c, b_c) over the display-sRGB channels of the selected pixels, in pixel order, and the number
+/// of terms (3 per pixel): the one loop under PSNR and MAE.
+template <typename Term>
+std::pair<double, std::size_t> sum_display_channels(const ImageRGBA& a, const ImageRGBA& b, const ImageMask* mask,
+                                                    const Term& term) {
+  require_same_size(a, b, mask);
+  double sum = 0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (!selected(mask, i)) continue;
+    const auto pa = display_rgb(a.pixels[i]), pb = display_rgb(b.pixels[i]);
+    for (int c = 0; c < 3; ++c) sum += term(pa[c], pb[c]);
+    n += 3;
+  }
+  return {sum, n};
 }
 
 // ---- FLIP colour spaces (core/colour.h's linear sRGB and XYZ, in float as in FLIP) ----
@@ -266,15 +284,9 @@ ImageMask object_mask_from_alpha(const ImageRGBA& reference) {
 }
 
 double psnr(const ImageRGBA& a, const ImageRGBA& b, const ImageMask* mask) {
-  require_same_size(a, b, mask);
-  double sum = 0;
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    if (!selected(mask, i)) continue;
-    const auto pa = display_rgb(a.pixels[i]), pb = display_rgb(b.pixels[i]);
-    for (int c = 0; c < 3; ++c) sum += double(pa[c] - pb[c]) * double(pa[c] - pb[c]);
-    n += 3;
-  }
+  const auto [sum, n] = sum_display_channels(a, b, mask, [](float pa, float pb) {
+    return double(pa - pb) * double(pa - pb);
+  });
   if (n == 0) return kPsnrCapDb;
   const double mse = sum / double(n);
   if (mse <= 0) return kPsnrCapDb;
@@ -282,15 +294,9 @@ double psnr(const ImageRGBA& a, const ImageRGBA& b, const ImageMask* mask) {
 }
 
 double mean_absolute_error(const ImageRGBA& a, const ImageRGBA& b, const ImageMask* mask) {
-  require_same_size(a, b, mask);
-  double sum = 0;
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    if (!selected(mask, i)) continue;
-    const auto pa = display_rgb(a.pixels[i]), pb = display_rgb(b.pixels[i]);
-    for (int c = 0; c < 3; ++c) sum += std::fabs(double(pa[c]) - double(pb[c]));
-    n += 3;
-  }
+  const auto [sum, n] = sum_display_channels(a, b, mask, [](float pa, float pb) {
+    return std::fabs(double(pa) - double(pb));
+  });
   return n == 0 ? 0.0 : sum / double(n);
 }
 

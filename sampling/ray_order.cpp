@@ -1,8 +1,5 @@
 #include "sampling/ray_order.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -10,6 +7,7 @@
 
 #include "core/errors.h"
 #include "core/hash.h"
+#include "core/parallel.h"
 
 namespace raysift::sampling {
 namespace {
@@ -152,12 +150,10 @@ RayQueue make_bucketed_queue(const ImageF& importance, const FractalPattern& pat
   // Random order inside each bucket: otherwise a bucket cut short by the budget would be filled in
   // scan order, densifying one image region only (RP paper section 5).
   queue.pixels.resize(base + keys.size());
-  tbb::parallel_for(tbb::blocked_range<int>(0, buckets), [&](const tbb::blocked_range<int>& r) {
-    for (int b = r.begin(); b < r.end(); ++b) {
-      const std::size_t first = start[std::size_t(b)], last = start[std::size_t(b) + 1];
-      std::sort(keys.begin() + std::ptrdiff_t(first), keys.begin() + std::ptrdiff_t(last));
-      for (std::size_t k = first; k < last; ++k) queue.pixels[base + k] = std::uint32_t(keys[k] & 0xFFFFFFFFu);
-    }
+  parallel_for_each(buckets, [&](int b) {
+    const std::size_t first = start[std::size_t(b)], last = start[std::size_t(b) + 1];
+    std::sort(keys.begin() + std::ptrdiff_t(first), keys.begin() + std::ptrdiff_t(last));
+    for (std::size_t k = first; k < last; ++k) queue.pixels[base + k] = std::uint32_t(keys[k] & 0xFFFFFFFFu);
   });
   return queue;
 }

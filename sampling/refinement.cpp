@@ -1,8 +1,5 @@
 #include "sampling/refinement.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -161,11 +158,8 @@ struct Candidate {
 // order, so the result does not depend on the thread count.
 template <typename Chunk>
 std::vector<Candidate> gather(std::size_t n, std::size_t chunk_size, const Chunk& chunk) {
-  const std::size_t chunks = (n + chunk_size - 1) / chunk_size;
-  std::vector<std::vector<Candidate>> parts(chunks);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t c = r.begin(); c < r.end(); ++c) chunk(c * chunk_size, std::min(n, (c + 1) * chunk_size), parts[c]);
-  });
+  std::vector<std::vector<Candidate>> parts((n + chunk_size - 1) / chunk_size);
+  parallel_chunks(n, chunk_size, [&](std::size_t c, std::size_t first, std::size_t last) { chunk(first, last, parts[c]); });
   std::vector<Candidate> out;
   for (const std::vector<Candidate>& part : parts) out.insert(out.end(), part.begin(), part.end());
   return out;
@@ -199,7 +193,6 @@ class Refiner {
     for (int l = 0; l < int(level_share_.size()); ++l) level_share_[l] = std::ldexp(1.0f, -l);
   }
 
-
   // Candidates no traced parent will offer: every in-image parent is background.
   // Their parents lie within S/2, so only open blocks (see mark_open_blocks) can hold them.
   void offer_orphans() {
@@ -228,14 +221,11 @@ class Refiner {
   // `pixels` were traced: marks and record()s them, then (with `offer`) offers the children they may have
   // completed. The last round skips the offers: nothing would pop them.
   void add_traced(const std::vector<std::uint32_t>& pixels, bool offer = true) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pixels.size(), 1024),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t i = r.begin(); i < r.end(); ++i) {
-                          traced_.pixels[pixels[i]] = 1;
-                          state_.pixels[pixels[i]] |= kKnown;
-                          if (offer) record(pixels[i]);
-                        }
-                      });
+    parallel_for_each(pixels.size(), [&](std::size_t i) {
+      traced_.pixels[pixels[i]] = 1;
+      state_.pixels[pixels[i]] |= kKnown;
+      if (offer) record(pixels[i]);
+    }, true, std::size_t(1024));
     if (!offer) return;
     push(gather(pixels.size(), 1024, [&](std::size_t first, std::size_t last, std::vector<Candidate>& out) {
       evaluate_all(last - first, [&](std::size_t i, std::vector<Ready>& ready) { children(pixels[first + i], ready); },

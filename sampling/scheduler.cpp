@@ -1,13 +1,13 @@
 #include "sampling/scheduler.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
 #include <atomic>
 #include <cmath>
+
+#include "core/parallel.h"
 
 namespace raysift::sampling {
 namespace {
@@ -27,11 +27,9 @@ void OvershootMargin::update(double frame_ms, double target_ms) {
 
 void trace_all(Span<const std::uint32_t> pixels, const TraceBatch& trace, ImageRGBA& image) {
   const std::size_t groups = (pixels.size() + kRayGroup - 1) / kRayGroup;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, groups), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t g = r.begin(); g < r.end(); ++g) {
-      const std::size_t first = g * kRayGroup, count = std::min(kRayGroup, pixels.size() - first);
-      trace_group(Span<const std::uint32_t>(pixels.data() + first, count), trace, image);
-    }
+  parallel_for_each(groups, [&](std::size_t g) {
+    const std::size_t first = g * kRayGroup, count = std::min(kRayGroup, pixels.size() - first);
+    trace_group(Span<const std::uint32_t>(pixels.data() + first, count), trace, image);
   });
 }
 
@@ -43,7 +41,7 @@ std::size_t trace_until(Span<const std::uint32_t> queue, const TraceBatch& trace
   const int workers = std::max(1, tbb::this_task_arena::max_concurrency());
   // One long-running task per worker; each checks the clock before claiming the next group, so at most
   // one group per worker runs past the deadline.
-  tbb::parallel_for(tbb::blocked_range<int>(0, workers, 1), [&](const tbb::blocked_range<int>&) {
+  parallel_for_each(workers, [&](int) {
     while (elapsed_ms() < deadline_ms) {
       const std::size_t g = next.fetch_add(1);
       if (g >= groups) break;

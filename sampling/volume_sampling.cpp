@@ -1,12 +1,10 @@
 #include "sampling/volume_sampling.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <array>
 
 #include "core/errors.h"
+#include "core/parallel.h"
 #include "core/timer.h"
 #include "volume/iso_values.h"
 
@@ -20,21 +18,21 @@ bool transparent_over_data(const volume::Volume& volume, const volume::TransferF
   return volume::max_tf_opacity(tf, info.value_min, info.value_max).opacity <= volume::IsoValueOptions{}.min_opacity;
 }
 
-/// The feature geometry a request asks for: the prepared mesh file, or built for the caster's view.
-FeatureGeometry request_geometry(const volume::Volume& volume, const volume::TransferFunction& tf,
-                                 const volume::RayCaster& caster, const SampledRenderRequest& request) {
-  if (!request.feature_mesh.empty()) return load_feature_geometry(request.feature_mesh, &volume);
-  FeatureGeometryOptions options = request.geometry;
-  if (!options.view) options.view = isosurface::FeatureView{caster.camera().spec(), request.features.importance.scale};
-  return build_feature_geometry(volume, tf, options, request.feature_cache);
-}
-
 FeatureGeometrySummary summarize(const FeatureGeometry& g) {
   return {g.mesh.triangles.size(), g.iso_values, g.hidden_iso_values, g.coarsening, g.from_cache, g.build_ms,
           g.level_ms,            g.probe_ms,    g.curvature_ms,        g.stages};
 }
 
 }  // namespace
+
+FeatureGeometry feature_geometry_for(const volume::Volume& volume, const volume::TransferFunction& tf,
+                                     const isosurface::FeatureView& view, const FeatureGeometryOptions& options,
+                                     const std::string& feature_mesh, isosurface::FeatureCache* cache) {
+  if (!feature_mesh.empty()) return load_feature_geometry(feature_mesh, &volume);
+  FeatureGeometryOptions o = options;
+  if (!o.view) o.view = view;
+  return build_feature_geometry(volume, tf, o, cache);
+}
 
 features::LineClassSet parse_feature_list(const std::string& list) {
   if (list == "none") return {};
@@ -54,12 +52,9 @@ ImageF frame_importance(const volume::RayCaster& caster, const FeatureGeometry* 
         geometry->mesh, geometry->curvature, caster.camera(), lines, features::BackgroundGeometry{}, options.importance);
     importance = features::upsample_importance(buffer, options.importance.threaded);
   }
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, importance.size(), 1 << 14),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t i = r.begin(); i != r.end(); ++i)
-                        importance.pixels[i] =
-                            background.pixels[i] ? -1.0f : std::min(1.0f, std::max(0.0f, importance.pixels[i]));
-                    });
+  parallel_for_each(importance.size(), [&](std::size_t i) {
+    importance.pixels[i] = background.pixels[i] ? -1.0f : std::min(1.0f, std::max(0.0f, importance.pixels[i]));
+  }, true, std::size_t(1) << 14);
   return importance;
 }
 
@@ -83,11 +78,9 @@ namespace {
 
 // In place and in parallel: a budgeted frame composites after its deadline, so this is pure overshoot.
 void composite_in_place(ImageRGBA& image, const Vec3f& background) {
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, image.size(), 1 << 14),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t i = r.begin(); i != r.end(); ++i)
-                        image.pixels[i] = volume::composite_over_background(image.pixels[i], background);
-                    });
+  parallel_for_each(image.size(), [&](std::size_t i) {
+    image.pixels[i] = volume::composite_over_background(image.pixels[i], background);
+  }, true, std::size_t(1) << 14);
 }
 
 }  // namespace
@@ -124,7 +117,10 @@ SampledRender render_sampled_volume(const volume::Volume& volume, const volume::
   // A TF that hides every value leaves no surface for lines (and an empty frame): render without them.
   const bool skip_features = wants_features && request.feature_mesh.empty() && transparent_over_data(volume, tf);
   const bool uses_features = wants_features && !skip_features;
-  const FeatureGeometry geometry = uses_features ? request_geometry(volume, tf, caster, request) : FeatureGeometry{};
+  const isosurface::FeatureView view{caster.camera().spec(), request.features.importance.scale};
+  const FeatureGeometry geometry =
+      uses_features ? feature_geometry_for(volume, tf, view, request.geometry, request.feature_mesh, request.feature_cache)
+                    : FeatureGeometry{};
   const FeatureGeometry* geometry_ptr = uses_features ? &geometry : nullptr;
 
   SampledRender out;

@@ -61,6 +61,13 @@ VolumeFrame render_volume_frame(const volume::RayCaster& caster, const FeatureGe
 /// Composites a premultiplied frame over `background` with the caster's shared rule.
 ImageRGBA composite_frame(const ImageRGBA& premultiplied, const Vec3f& background);
 
+/// The feature geometry a render asks for: the prepared mesh `feature_mesh` when given (checked against the
+/// volume), else built with `options` (for `view` unless options.view is set), through `cache` when given.
+/// \throw as isosurface::build_feature_geometry / load_feature_geometry.
+FeatureGeometry feature_geometry_for(const volume::Volume& volume, const volume::TransferFunction& tf,
+                                     const isosurface::FeatureView& view, const FeatureGeometryOptions& options = {},
+                                     const std::string& feature_mesh = "", isosurface::FeatureCache* cache = nullptr);
+
 /// What `raysift render --mode prioritized|subsample` asks for.
 struct SampledRenderRequest {
   SamplingOptions sampling;

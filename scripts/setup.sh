@@ -15,7 +15,7 @@ packages=(cmake g++ make pkg-config ccache zlib1g-dev
   libtbb-dev nlohmann-json3-dev libcli11-dev)
 case "$mode" in
   demo) build_all=OFF ;;
-  test) build_all=ON; packages+=(libgtest-dev libbenchmark-dev libopenvdb-tools openimageio-tools) ;;
+  test) build_all=ON; packages+=(libgtest-dev libopenvdb-tools openimageio-tools) ;;
   *) echo "usage: scripts/setup.sh demo|test" >&2; exit 2 ;;
 esac
 source scripts/install_missing.sh

@@ -1,13 +1,13 @@
 #include "volume/iso_visibility.h"
 
 #include <openvdb/tools/Dense.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 
 #include "core/errors.h"
+#include "core/parallel.h"
 #include "volume/detail/vdb_grid.h"
 
 namespace raysift::volume {
@@ -125,10 +125,7 @@ std::vector<bool> visible_iso_surfaces(const Volume& volume, const TransferFunct
         march(block, step, iso_values, options, start, dir, 2 * radius, crossed, seen[d]);
       }
   };
-  if (options.threaded)
-    tbb::parallel_for(std::size_t(0), dirs.size(), one_direction);
-  else
-    for (std::size_t d = 0; d < dirs.size(); ++d) one_direction(d);
+  parallel_for_each(dirs.size(), one_direction, options.threaded);
   const double background = volume.background();
   for (std::size_t k = 0; k < iso_values.size(); ++k) {
     bool any = iso_values[k] <= background;

@@ -6,9 +6,6 @@
 // would give zero opacity: the image is identical to the brute-force path.
 #include "volume/raycaster.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -72,6 +69,14 @@ void validate(const RenderOptions& o) {
   if (!p.headlight && !(is_finite(p.light_dir_ws) && length(p.light_dir_ws) > 0))
     throw InvalidInput("light direction must be finite and non-zero");
 }
+
+struct Footprint;
+
+/// Index space -> camera axes (rows right, up, forward), and the near plane of the background test.
+struct ViewTransform {
+  double to_view[3][3];
+  double near;
+};
 
 }  // namespace
 
@@ -237,6 +242,9 @@ struct RayCaster::Impl {
            eye_is.x <= hi.x + slack.x && eye_is.y <= hi.y + slack.y && eye_is.z <= hi.z + slack.z;
   }
   void find_surface_blocks();
+  ViewTransform view_transform() const;
+  /// Appends the footprints of surface block i's outer faces that a ray from the eye can enter.
+  void face_footprints(std::size_t i, const ViewTransform& view, std::vector<Footprint>& out) const;
 };
 
 RaySample RayCaster::Impl::trace(int x, int y) const {
@@ -451,6 +459,45 @@ void fill_footprint(const Footprint& f, int r0, int r1, Image<std::uint8_t>& hit
 
 }  // namespace
 
+ViewTransform RayCaster::Impl::view_transform() const {
+  ViewTransform v;
+  // Camera axes in index space: view = rows(right, up, forward) · index_to_world.
+  const Vec3d axes[3] = {camera.right(), camera.image_up(), camera.forward()};
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      v.to_view[r][c] = axes[r].x * index_to_world[0][c] + axes[r].y * index_to_world[1][c] +
+                        axes[r].z * index_to_world[2][c];
+  // The eye is more than a block from every face, so clipping this close loses no in-view ray.
+  double voxel_ws = kInf;
+  for (int c = 0; c < 3; ++c)
+    voxel_ws = std::min(voxel_ws, length(Vec3d{index_to_world[0][c], index_to_world[1][c], index_to_world[2][c]}));
+  v.near = 1e-3 * voxel_ws;
+  return v;
+}
+
+void RayCaster::Impl::face_footprints(std::size_t i, const ViewTransform& view, std::vector<Footprint>& out) const {
+  Vec3d lo, hi;
+  block_box(surface_blocks[i], lo, hi);
+  for (int a = 0; a < 3; ++a)
+    for (int side = 0; side < 2; ++side) {
+      const double plane = side ? hi[a] : lo[a];
+      // Only faces seen from outside can be where a ray enters (edge-on ones too, for the slack).
+      if (!((outer_faces[i] >> (2 * a + side)) & 1u) ||
+          (side ? eye_is[a] < plane - kBlockSlackVoxels : eye_is[a] > plane + kBlockSlackVoxels))
+        continue;
+      const int b = (a + 1) % 3, c = (a + 2) % 3;
+      Vec3d p[4];
+      for (int q = 0; q < 4; ++q) {
+        p[q][a] = plane;
+        p[q][b] = (q == 1 || q == 2) ? hi[b] : lo[b];
+        p[q][c] = (q >= 2) ? hi[c] : lo[c];
+      }
+      Footprint f;
+      f.block = surface_blocks[i];
+      if (project_face(p, view.to_view, eye_is, view.near, camera, f)) out.push_back(f);
+    }
+}
+
 Image<std::uint8_t> RayCaster::background_mask(bool threaded) const {
   const Impl& m = *impl_;
   const int w = width(), h = height();
@@ -470,67 +517,24 @@ Image<std::uint8_t> RayCaster::background_mask(bool threaded) const {
     }, threaded);
     return to_background();
   }
-  // Camera axes in index space: view = rows(right, up, forward) · index_to_world.
-  double to_view[3][3];
-  const Vec3d axes[3] = {m.camera.right(), m.camera.image_up(), m.camera.forward()};
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c)
-      to_view[r][c] = axes[r].x * m.index_to_world[0][c] + axes[r].y * m.index_to_world[1][c] +
-                      axes[r].z * m.index_to_world[2][c];
-  // The eye is more than a block from every face, so clipping this close loses no in-view ray.
-  double voxel_ws = kInf;
-  for (int c = 0; c < 3; ++c)
-    voxel_ws = std::min(voxel_ws, length(Vec3d{m.index_to_world[0][c], m.index_to_world[1][c], m.index_to_world[2][c]}));
-  const double near = 1e-3 * voxel_ws;
-
+  const ViewTransform view = m.view_transform();
   constexpr std::size_t kChunk = 512;
-  const std::size_t blocks = m.surface_blocks.size(), chunks = (blocks + kChunk - 1) / kChunk;
-  std::vector<std::vector<Footprint>> parts(chunks);
-  auto project_chunk = [&](std::size_t c) {
-    for (std::size_t i = c * kChunk; i < std::min(blocks, (c + 1) * kChunk); ++i) {
-      Vec3d lo, hi;
-      m.block_box(m.surface_blocks[i], lo, hi);
-      for (int a = 0; a < 3; ++a)
-        for (int side = 0; side < 2; ++side) {
-          const double plane = side ? hi[a] : lo[a];
-          // Only faces seen from outside can be where a ray enters (edge-on ones too, for the slack).
-          if (!((m.outer_faces[i] >> (2 * a + side)) & 1u) ||
-              (side ? m.eye_is[a] < plane - kBlockSlackVoxels : m.eye_is[a] > plane + kBlockSlackVoxels))
-            continue;
-          const int b = (a + 1) % 3, c2 = (a + 2) % 3;
-          Vec3d p[4];
-          for (int q = 0; q < 4; ++q) {
-            p[q][a] = plane;
-            p[q][b] = (q == 1 || q == 2) ? hi[b] : lo[b];
-            p[q][c2] = (q >= 2) ? hi[c2] : lo[c2];
-          }
-          Footprint f;
-          f.block = m.surface_blocks[i];
-          if (project_face(p, to_view, m.eye_is, near, m.camera, f)) parts[c].push_back(f);
-        }
-    }
-  };
+  const std::size_t blocks = m.surface_blocks.size();
+  std::vector<std::vector<Footprint>> parts((blocks + kChunk - 1) / kChunk);
+  parallel_chunks(blocks, kChunk, [&](std::size_t c, std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) m.face_footprints(i, view, parts[c]);
+  }, threaded);
   // Bins: footprints per band of rows, in block order (the result is an OR, so order only fixes the work).
   const int bands = (h + kMaskBandRows - 1) / kMaskBandRows;
   std::vector<std::vector<const Footprint*>> bins(static_cast<std::size_t>(bands));
-  auto run = [&](std::size_t n, const auto& body) {
-    if (threaded) {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
-      });
-    } else {
-      for (std::size_t i = 0; i < n; ++i) body(i);
-    }
-  };
-  run(chunks, project_chunk);
   for (const auto& part : parts)
     for (const Footprint& f : part)
       for (int b = f.r0 / kMaskBandRows; b <= f.r1 / kMaskBandRows; ++b) bins[std::size_t(b)].push_back(&f);
-  run(std::size_t(bands), [&](std::size_t band) {
+  parallel_for_each(std::size_t(bands), [&](std::size_t band) {
     const int r0 = int(band) * kMaskBandRows, r1 = std::min(h - 1, r0 + kMaskBandRows - 1);
     for (const Footprint* f : bins[band])
       fill_footprint(*f, r0, r1, hit, [&](int x, int y) { return m.ray_hits_block(m.pixel_inv_dir(x, y), f->block); });
-  });
+  }, threaded);
   return to_background();
 }
 
@@ -659,26 +663,20 @@ RenderResult render_full(const RayCaster& caster, const ProgressCallback& progre
   const Vec3f background = caster.options().background;
   std::atomic<std::uint64_t> samples{0};
   std::atomic<int> tiles_done{0};
-  auto run_tiles = [&](const tbb::blocked_range<int>& r) {
-    for (int tile = r.begin(); tile < r.end(); ++tile) {
-      const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
-      std::uint64_t tile_samples = 0;
-      for (int y = y0; y < std::min(y0 + kTile, h); ++y)
-        for (int x = x0; x < std::min(x0 + kTile, w); ++x) {
-          const RaySample s = caster.trace(x, y);
-          result.image(x, y) = composite_over_background(s.color, background);
-          result.depth(x, y) = s.depth;
-          tile_samples += s.samples;
-        }
-      samples += tile_samples;
-      const int done = ++tiles_done;
-      if (progress) progress(double(done) / tile_count);
-    }
-  };
-  if (threaded)
-    tbb::parallel_for(tbb::blocked_range<int>(0, tile_count, 1), run_tiles);
-  else
-    run_tiles(tbb::blocked_range<int>(0, tile_count));
+  parallel_for_each(tile_count, [&](int tile) {
+    const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
+    std::uint64_t tile_samples = 0;
+    for (int y = y0; y < std::min(y0 + kTile, h); ++y)
+      for (int x = x0; x < std::min(x0 + kTile, w); ++x) {
+        const RaySample s = caster.trace(x, y);
+        result.image(x, y) = composite_over_background(s.color, background);
+        result.depth(x, y) = s.depth;
+        tile_samples += s.samples;
+      }
+    samples += tile_samples;
+    const int done = ++tiles_done;
+    if (progress) progress(double(done) / tile_count);
+  }, threaded);
   result.samples = samples;
   result.rays_traced = std::uint64_t(w) * std::uint64_t(h);
   return result;

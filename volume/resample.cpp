@@ -1,11 +1,10 @@
 #include "volume/resample.h"
 
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <vector>
 
 #include "core/errors.h"
+#include "core/parallel.h"
 #include "volume/detail/vdb_grid.h"
 
 namespace raysift::volume {
@@ -69,7 +68,7 @@ Volume downsample(const Volume& volume, int factor) {
   group_start.push_back(leaves.size());
 
   std::vector<Leaf*> coarse(group_start.size() - 1, nullptr);
-  tbb::parallel_for(std::size_t(0), coarse.size(), [&](std::size_t g) {
+  parallel_for_each(coarse.size(), [&](std::size_t g) {
     auto* leaf = new Leaf(coarse_origin(leaves[group_start[g]]), background, false);
     for (std::size_t i = group_start[g]; i < group_start[g + 1]; ++i) average_leaf(*leaves[i], factor, background, *leaf);
     coarse[g] = leaf;

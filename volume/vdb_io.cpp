@@ -239,4 +239,13 @@ std::vector<GridInfo> inspect_vdb(const std::string& path) {
   return infos;
 }
 
+std::optional<Bbox3d> active_world_box(const std::string& path, const std::string& grid) {
+  const std::vector<GridInfo> grids = inspect_vdb(path);
+  const std::string name = !grid.empty() ? grid : default_grid_name(grids);
+  for (const GridInfo& g : grids)
+    if (g.name == name && g.type == "float" && g.active_voxels > 0)
+      return Bbox3d{g.bbox_min - g.voxel_size * 0.5, g.bbox_max + g.voxel_size * 0.5};
+  return std::nullopt;
+}
+
 }  // namespace raysift::volume

@@ -3,6 +3,7 @@
 /// file and the problem (OpenVDB's own exceptions never escape). Files are read fully into memory (no delayed
 /// loading), so a truncated file fails here, not later inside a renderer.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -57,5 +58,10 @@ void save_vdb(const std::string& path, const Volume& volume, const SaveVdbOption
 /// Describes every grid in the file, of any value type. For non-float grids value_min/value_max/background are 0.
 /// \throw IoError as load_vdb.
 std::vector<GridInfo> inspect_vdb(const std::string& path);
+
+/// World box of the voxels (active voxel centres grown by half a voxel) of one float grid of the file, from
+/// inspect_vdb; nullopt when that grid is missing, not a float grid or empty.
+/// \param grid "" = default_grid_name of the file's grids. \throw IoError as inspect_vdb.
+std::optional<Bbox3d> active_world_box(const std::string& path, const std::string& grid = "");
 
 }  // namespace raysift::volume

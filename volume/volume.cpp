@@ -63,6 +63,12 @@ std::uint64_t grid_bytes_upper_bound(std::uint64_t active_voxels) {
   return saturating_product(active_voxels / 2 + 1, 9);
 }
 
+std::uint64_t dense_grid_bytes_upper_bound(const Vec3i& dims) {
+  if (dims.x <= 0 || dims.y <= 0 || dims.z <= 0) return 0;
+  return grid_bytes_upper_bound(
+      saturating_product(saturating_product(std::uint64_t(dims.x), std::uint64_t(dims.y)), std::uint64_t(dims.z)));
+}
+
 Volume::Volume() : impl_(empty_impl()) {}
 Volume::Volume(std::shared_ptr<Impl> impl) : impl_(std::move(impl)) { RAYSIFT_CHECK(impl_ && impl_->grid); }
 

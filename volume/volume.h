@@ -44,6 +44,8 @@ struct DenseSpec {
 /// Upper bound on the memory of a grid with `active_voxels` active voxels in 8^3 leaves: 4 bytes per value
 /// plus the leaf masks and headers (about 4.3 bytes per voxel), rounded up to 4.5. Saturates at UINT64_MAX.
 std::uint64_t grid_bytes_upper_bound(std::uint64_t active_voxels);
+/// grid_bytes_upper_bound of a grid with every voxel of `dims` active (0 if a dim is not positive).
+std::uint64_t dense_grid_bytes_upper_bound(const Vec3i& dims);
 
 class Volume {
  public:

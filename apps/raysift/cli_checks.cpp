@@ -38,4 +38,21 @@ CLI::Validator has_extension(const std::vector<std::string>& extensions) {
       "PATH(" + names + ")", "extension");
 }
 
+std::optional<Vec3d> parse_vec3(const std::string& text) {
+  std::istringstream in(text);
+  Vec3d v;
+  char c1 = 0, c2 = 0;
+  if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || !(in >> std::ws).eof() || !is_finite(v))
+    return std::nullopt;
+  return v;
+}
+
+CLI::Validator vec3_text() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        return parse_vec3(text) ? "" : "must be three finite numbers x,y,z, got '" + text + "'";
+      },
+      "X,Y,Z", "vec3");
+}
+
 }  // namespace raysift::app

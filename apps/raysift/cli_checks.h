@@ -3,6 +3,7 @@
 /// parsing (exit 2 naming the flag) and shown in --help next to the flag's default.
 #include <CLI/CLI.hpp>
 #include <map>
+#include <optional>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -23,6 +24,12 @@ CLI::Validator number_in(double lo, double hi, End lo_end = End::Closed, End hi_
 
 /// A path ending in one of `extensions` (e.g. {".exr", ".png"}).
 CLI::Validator has_extension(const std::vector<std::string>& extensions);
+
+/// "x,y,z" as three finite numbers (spaces allowed around them); nullopt for anything else.
+std::optional<Vec3d> parse_vec3(const std::string& text);
+
+/// An entry "x,y,z" of three finite numbers, for lists of points split at another delimiter (e.g. ';').
+CLI::Validator vec3_text();
 
 /// Adds `flag` choosing one of `names` into the enum `value`: an unknown name exits 2 listing the names, and
 /// --help shows the names and the name of `value`'s initial value as the default.

@@ -79,7 +79,7 @@ RegisterCommand reg(
           ->capture_default_str();
       sub.footer("Example:\n  raysift demo --scene datasets/engine_ct_scene.json -o build/demo.png --stats build/demo.json\n");
       return [opt, &common] {
-        const VolumeInput in = load_volume_input("", "", "", false, common.scene_path, common, "demo");
+        const VolumeInput in = load_volume_input(VolumeFlags{}, common.scene_path, common, "demo");
         if (!in.tf) throw UsageError("demo needs a --scene with a 'transfer_function'; see --help");
         CameraSpec camera = in.scene.camera ? *in.scene.camera : volume::fit_camera(in.volume, opt->width, opt->height);
         camera.width = opt->width;

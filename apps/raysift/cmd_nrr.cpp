@@ -18,7 +18,9 @@ namespace raysift::app {
 namespace {
 
 struct NrrCliOptions {
-  std::string mesh, out_dir, mask_dir, views_file, eyes, region;
+  std::string mesh, out_dir, mask_dir, views_file;
+  std::vector<std::string> eyes;  ///< "x,y,z" each (checked by CLI11)
+  std::string region;
   std::vector<double> target, up{0, 1, 0};
   double fov_y_deg = 45.0;
   int resolution = 1024;
@@ -45,11 +47,7 @@ nrr::ViewSet views_from_options(const NrrCliOptions& o) {
     if (o.eyes.empty() || o.target.empty())
       throw UsageError("--view-region needs --eyes \"x,y,z;x,y,z...\" and --target x,y,z; see --help");
     std::vector<Vec3d> eyes;
-    try {
-      eyes = nrr::parse_eye_list(o.eyes);
-    } catch (const InvalidInput& e) {
-      bad_flag("--eyes", "three finite numbers x,y,z per eye", e.what());
-    }
+    for (const std::string& e : o.eyes) eyes.push_back(*parse_vec3(e));
     if (int(eyes.size()) != nrr::corner_count(region))
       bad_flag("--eyes", std::to_string(nrr::corner_count(region)) + " eyes for a " + o.region,
                std::to_string(eyes.size()) + " eyes");
@@ -75,7 +73,8 @@ void add_options(CLI::App& sub, NrrCliOptions& o) {
                     "views JSON: a list of cameras, or {\"views\": [...], \"intermediate_views\": [...]}");
   views->add_option("--view-region", o.region, "eyes' region (with --eyes, --target)")
       ->check(CLI::IsMember({"segment", "triangle", "rectangle"}));
-  views->add_option("--eyes", o.eyes, "corner eyes \"x,y,z;x,y,z[;...]\" (2, 3 or 4, rectangle in perimeter order)");
+  views->add_option("--eyes", o.eyes, "corner eyes \"x,y,z;x,y,z[;...]\" (2, 3 or 4, rectangle in perimeter order)")
+      ->delimiter(';')->check(vec3_text());
   views->add_option("--target", o.target, "common look-at point x,y,z for --view-region")->delimiter(',')->expected(3)
       ->check(number_in(-INFINITY, INFINITY));
   views->add_option("--up", o.up, "common up vector for --view-region")->delimiter(',')->expected(3)

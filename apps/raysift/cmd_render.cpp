@@ -2,22 +2,20 @@
 // caster) -> run the selected mode -> write. A new mode adds one entry to `modes()` (and its flags in
 // render_flags.cpp); everything before and after the dispatch is shared, so all modes composite and write alike.
 #include <cstdio>
-#include <filesystem>
 #include <iostream>
 #include <map>
 #include <memory>
-#include <sstream>
 
 #include "apps/raysift/command.h"
 #include "apps/raysift/guard_flags.h"
 #include "apps/raysift/render_flags.h"
+#include "apps/raysift/render_path.h"
 #include "apps/raysift/sampling_stats.h"
 #include "core/file_util.h"
 #include "core/image.h"
-#include "core/signals.h"
 #include "core/progress.h"
+#include "core/signals.h"
 #include "core/timer.h"
-#include "sampling/camera_path.h"
 
 namespace raysift::app {
 namespace {
@@ -68,56 +66,16 @@ std::vector<std::string> mode_list() {
   return names;
 }
 
-void trace_one_pixel(const std::string& text, const volume::RayCaster& caster) {
-  int x = -1, y = -1;
-  char comma = 0;
-  std::istringstream s(text);
-  if (!(s >> x >> comma >> y) || comma != ',' || !s.eof() || x < 0 || y < 0 || x >= caster.width() ||
-      y >= caster.height())
+/// --pixel x,y (two non-negative integers, checked by CLI11) inside the image: trace it alone and print it.
+void trace_one_pixel(const std::vector<int>& pixel, const volume::RayCaster& caster) {
+  const int x = pixel[0], y = pixel[1];
+  if (x >= caster.width() || y >= caster.height())
     bad_flag("--pixel", "x,y inside the " + std::to_string(caster.width()) + "x" + std::to_string(caster.height()) +
-                            " image", text);
+                            " image", std::to_string(x) + "," + std::to_string(y));
   const volume::RaySample r = caster.trace(x, y);
   const Rgba c = volume::composite_over_background(r.color, caster.options().background);
   std::printf("pixel %d,%d: premultiplied %.6g %.6g %.6g %.6g  composited %.6g %.6g %.6g  depth %.6g  samples %u\n",
               x, y, r.color.r, r.color.g, r.color.b, r.color.a, c.r, c.g, c.b, r.depth, r.samples);
-}
-
-void render_path(const PathCliOptions& p, const RenderCliOptions& o, const RenderInputs& in, const CommonOptions& common) {
-  sampling::PathRenderRequest request;
-  request.camera_path = p.camera_path;
-  request.options.sampling = in.sampled.sampling;
-  request.options.features.lines = in.sampled.features;
-  request.options.features.use_saliency = p.use_saliency;
-  request.options.target_fps = p.target_fps;
-  request.options.compare_full = p.compare_full;
-  request.geometry = in.sampled.geometry;
-  request.feature_mesh = in.sampled.feature_mesh;
-  request.feature_cache = in.sampled.feature_cache;
-  // Frames stream out one by one, each atomically; the manifest, written last, marks a complete sequence, so a
-  // stale one from an earlier run must not outlive the first new frame.
-  const std::string manifest = sampling::frame_manifest_name(o.out);
-  std::error_code ec;
-  std::filesystem::remove(manifest, ec);
-  const sampling::PathRenderResult r = sampling::run_path_request(
-      in.volume, *in.tf, in.options, in.camera, request, [&](const sampling::PathFrame& frame, const ImageRGBA& image) {
-        const std::string name = sampling::frame_file_name(o.out, frame.index);
-        if (file_extension(name) != ".png") return write_image(name, image);
-        ImageRGBA opaque = image;  // composited colour: show it opaque, as a single frame does
-        for (Rgba& px : opaque.pixels) px.a = 1.0f;
-        write_image(name, opaque);
-      });
-  Json stats = path_stats_json(r.frames, p.target_fps);
-  stats["camera_path"] = p.camera_path;
-  stats["frame_files"] = {sampling::frame_file_name(o.out, 0), sampling::frame_file_name(o.out, int(r.frames.size()) - 1)};
-  stats["times_ms"] = {{"features_setup", r.features_setup_ms}, {"total", r.total_ms}};
-  stats["mode"] = o.mode;
-  Json files = Json::array();
-  for (const sampling::PathFrame& f : r.frames) files.push_back(sampling::frame_file_name(o.out, f.index));
-  write_json_file(manifest, {{"camera_path", p.camera_path}, {"frames", r.frames.size()}, {"files", files}});
-  stats["manifest"] = manifest;
-  if (common.verbose)
-    std::cerr << "rendered " << r.frames.size() << " frames to " << o.out << " in " << r.total_ms << " ms\n";
-  write_stats_if_requested(common, stats);
 }
 
 RegisterCommand reg(

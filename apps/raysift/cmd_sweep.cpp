@@ -1,32 +1,24 @@
 // raysift sweep: the speed/accuracy trade of one scene (sampling/trade.h) as CSV, optionally plotted.
-#include <cstdio>
-#include <cstdlib>
-#include <fstream>
 #include <iostream>
 #include <memory>
-#include <sstream>
 
 #include <cmath>
 
 #include "apps/raysift/cli_checks.h"
 #include "apps/raysift/command.h"
 #include "apps/raysift/guard_flags.h"
-#include "apps/raysift/sampling_flags.h"
 #include "apps/raysift/run_program.h"
+#include "apps/raysift/sampling_flags.h"
 #include "apps/raysift/volume_input.h"
 #include "core/file_util.h"
-#include "core/scene.h"
-#include "isosurface/feature_geometry.h"
 #include "sampling/trade.h"
-#include "volume/vdb_io.h"
 
 namespace raysift::app {
 namespace {
 
 struct SweepOptions {
   std::string scene, out, plot;
-  std::string grid, tf;
-  bool tf_normalized = false;
+  VolumeFlags input;  ///< --grid, --tf, --tf-normalized (the volume is the scene's)
   std::vector<double> fractions = sampling::TradeOptions{}.ray_fractions;
   std::vector<double> budgets_ms, time_fractions, steps, early_terminations;
   std::string features = "contours,silhouettes";
@@ -43,14 +35,6 @@ CLI::Option* add_list(CLI::App& sub, const std::string& flag, std::vector<double
   return sub.add_option(flag, values, help)->delimiter(',')->check(check);
 }
 
-void write_text(const std::string& path, const std::string& text) {
-  write_atomically(path, [&](const std::string& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
-    out << text;
-    if (!out) throw IoError(file_message(path, "cannot write"));
-  });
-}
-
 /// Runs scripts/plot_trade.py with an argument vector (no shell, so no quoting of paths).
 void write_plot(const std::string& csv_path, const std::string& png_path, const std::string& title) {
   const std::string script = std::string(RAYSIFT_SOURCE_DIR) + "/scripts/plot_trade.py";
@@ -60,97 +44,91 @@ void write_plot(const std::string& csv_path, const std::string& png_path, const 
                                          "apt-get install python3-matplotlib); the CSV was written"));
 }
 
-/// The feature geometry fitted to the sweep's view and importance resolution.
-isosurface::FeatureGeometryOptions feature_options(const CameraSpec& camera, const sampling::TradeOptions& trade) {
-  isosurface::FeatureGeometryOptions o;
-  o.view = isosurface::FeatureView{camera, trade.features.importance.scale};
-  return o;
+void add_options(CLI::App& sub, SweepOptions& o) {
+  sub.add_option("SCENE", o.scene, "scene JSON (volume, transfer_function, camera)")->required();
+  sub.add_option("-o,--out", o.out, "CSV output, one row per (mode, fraction)")->required()
+      ->check(has_extension({".csv"}));
+  add_volume_flags(sub, o.input, "transfer function JSON (default: the scene's)", /*positional=*/false);
+  auto* rows = sub.add_option_group("Rows");
+  add_list(*rows, "--ray-fractions", o.fractions, "ray fractions", number_in(0, 1, End::Open))->capture_default_str();
+  add_list(*rows, "--budgets-ms", o.budgets_ms, "also prioritized and control rows at these frame budgets (ms)",
+           number_in(0, INFINITY, End::Open));
+  add_list(*rows, "--time-fractions", o.time_fractions,
+           "also prioritized and control rows at these fractions of the full frame time", number_in(0, 1, End::Open));
+  add_list(*rows, "--steps", o.steps, "also full renders at these sampling steps (voxels)", number_in(0, 64, End::Open));
+  add_list(*rows, "--early-termination", o.early_terminations,
+           "also full renders at these early-termination opacities", number_in(0, 1, End::Open));
+  rows->add_option("--repeats", o.repeats, "frames per row; times are the minimum")
+      ->check(CLI::PositiveNumber)->capture_default_str();
+  auto* render = sub.add_option_group("Rendering");
+  render->add_option("--features", o.features, "line classes of the prioritized rows")->capture_default_str();
+  add_alpha_option(*render, o.alpha);
+  render->add_option("--feature-mesh", o.feature_mesh, "prepared feature mesh instead of the iso-surfaces");
+  render->add_option("--shading", o.shading, "none|phong")->check(CLI::IsMember({"none", "phong"}))
+      ->capture_default_str();
+  render->add_option("--width", o.width, "image width (default: the scene camera's)")->check(image_side());
+  render->add_option("--height", o.height, "image height (default: the scene camera's)")->check(image_side());
+  sub.add_option("--plot", o.plot, "also draw error vs frame time for every mode and knob (PNG)")
+      ->check(has_extension({".png"}));
+  sub.footer(
+      "Example:\n  raysift sweep datasets/engine_ct_scene.json --ray-fractions 0.1,0.2,0.4,0.7 -o trade.csv "
+      "--plot trade.png\n");
+}
+
+sampling::TradeOptions trade_options(const SweepOptions& o, const CommonOptions& common) {
+  sampling::TradeOptions trade;
+  trade.ray_fractions = o.fractions;
+  trade.budgets_ms = o.budgets_ms;
+  trade.time_fractions = o.time_fractions;
+  trade.repeats = o.repeats;
+  trade.sampling.seed = common.seed;
+  if (!o.alpha.empty()) std::copy(o.alpha.begin(), o.alpha.end(), trade.sampling.mapping.alpha.begin());
+  try {
+    trade.features.classes = sampling::parse_feature_list(o.features);
+  } catch (const InvalidInput& e) {
+    throw UsageError(std::string("--features: ") + e.what() + "; see --help");
+  }
+  return trade;
+}
+
+void run(const SweepOptions& o, const CommonOptions& common) {
+  const sampling::TradeOptions trade = trade_options(o, common);
+  const VolumeInput in = load_volume_input(o.input, o.scene, common, "sweep");
+  if (!in.tf) throw InvalidInput(file_message(o.scene, "the scene has no 'transfer_function'"));
+  CameraSpec camera = in.scene.camera ? *in.scene.camera : volume::fit_camera(in.volume, CameraSpec{}.width, CameraSpec{}.height);
+  if (o.width != -1) camera.width = o.width;
+  if (o.height != -1) camera.height = o.height;
+  volume::RenderOptions render;
+  render.shading = o.shading == "phong" ? volume::Shading::Phong : volume::Shading::None;
+  const volume::RayCaster caster(in.volume, *in.tf, camera, render);
+
+  const bool uses_features = !trade.features.classes.is_empty();
+  const isosurface::FeatureView view{camera, trade.features.importance.scale};
+  const sampling::FeatureGeometry geometry =
+      uses_features ? sampling::feature_geometry_for(in.volume, *in.tf, view, {}, o.feature_mesh) : sampling::FeatureGeometry{};
+  sampling::TradeResult result = sampling::run_trade(caster, uses_features ? &geometry : nullptr, trade);
+  const std::vector<sampling::TradeRow> knobs = sampling::run_render_knobs(in.volume, *in.tf, camera, render, o.steps,
+                                                                           o.early_terminations, result, trade);
+  result.rows.insert(result.rows.end(), knobs.begin(), knobs.end());
+  const std::string csv = sampling::trade_csv(result.rows);
+  write_text_file(o.out, csv);
+  if (!common.quiet) std::cout << csv;
+  if (!o.plot.empty())
+    write_plot(o.out, o.plot, o.scene + " " + std::to_string(camera.width) + "x" + std::to_string(camera.height));
+  write_stats_if_requested(common, {{"rows", result.rows.size()},
+                                    {"width", camera.width},
+                                    {"height", camera.height},
+                                    {"features_setup_ms", geometry.build_ms},
+                                    {"feature_triangles", geometry.mesh.triangles.size()}});
 }
 
 RegisterCommand reg(
     "sweep", "speed/accuracy trade: full render, then prioritized, control and subsample at each ray fraction",
     [](CLI::App& sub, CommonOptions& common) -> RunFunction {
       auto opt = std::make_shared<SweepOptions>();
-      sub.add_option("SCENE", opt->scene, "scene JSON (volume, transfer_function, camera)")->required();
-      sub.add_option("-o,--out", opt->out, "CSV output, one row per (mode, fraction)")->required()
-          ->check(has_extension({".csv"}));
-      sub.add_option("--grid", opt->grid, "grid name (default: the scene's, else the first non-empty float grid)");
-      sub.add_option("--tf", opt->tf, "transfer function JSON (default: the scene's)");
-      sub.add_flag("--tf-normalized", opt->tf_normalized, "TF x values are 0..1 over the data range");
-      auto* rows = sub.add_option_group("Rows");
-      add_list(*rows, "--ray-fractions", opt->fractions, "ray fractions", number_in(0, 1, End::Open))
-          ->capture_default_str();
-      add_list(*rows, "--budgets-ms", opt->budgets_ms, "also prioritized and control rows at these frame budgets (ms)",
-               number_in(0, INFINITY, End::Open));
-      add_list(*rows, "--time-fractions", opt->time_fractions,
-               "also prioritized and control rows at these fractions of the full frame time",
-               number_in(0, 1, End::Open));
-      add_list(*rows, "--steps", opt->steps, "also full renders at these sampling steps (voxels)",
-               number_in(0, 64, End::Open));
-      add_list(*rows, "--early-termination", opt->early_terminations,
-               "also full renders at these early-termination opacities", number_in(0, 1, End::Open));
-      rows->add_option("--repeats", opt->repeats, "frames per row; times are the minimum")
-          ->check(CLI::PositiveNumber)->capture_default_str();
-      auto* render = sub.add_option_group("Rendering");
-      render->add_option("--features", opt->features, "line classes of the prioritized rows")->capture_default_str();
-      add_alpha_option(*render, opt->alpha);
-      render->add_option("--feature-mesh", opt->feature_mesh, "prepared feature mesh instead of the iso-surfaces");
-      render->add_option("--shading", opt->shading, "none|phong")->check(CLI::IsMember({"none", "phong"}))
-          ->capture_default_str();
-      render->add_option("--width", opt->width, "image width (default: the scene camera's)")->check(image_side());
-      render->add_option("--height", opt->height, "image height (default: the scene camera's)")->check(image_side());
-      sub.add_option("--plot", opt->plot, "also draw error vs frame time for every mode and knob (PNG)")
-          ->check(has_extension({".png"}));
-      sub.footer(
-          "Example:\n  raysift sweep datasets/engine_ct_scene.json --ray-fractions 0.1,0.2,0.4,0.7 -o trade.csv "
-          "--plot trade.png\n");
+      add_options(sub, *opt);
       add_non_finite_flag(sub, common);
-      return [opt, &common] {
-        sampling::TradeOptions trade;
-        trade.ray_fractions = opt->fractions;
-        trade.budgets_ms = opt->budgets_ms;
-        trade.time_fractions = opt->time_fractions;
-        trade.repeats = opt->repeats;
-        trade.sampling.seed = common.seed;
-        if (!opt->alpha.empty()) std::copy(opt->alpha.begin(), opt->alpha.end(), trade.sampling.mapping.alpha.begin());
-        try {
-          trade.features.classes = sampling::parse_feature_list(opt->features);
-        } catch (const InvalidInput& e) {
-          throw UsageError(std::string("--features: ") + e.what() + "; see --help");
-        }
-
-        const VolumeInput in = load_volume_input("", opt->grid, opt->tf, opt->tf_normalized, opt->scene, common, "sweep");
-        if (!in.tf) throw InvalidInput(file_message(opt->scene, "the scene has no 'transfer_function'"));
-        CameraSpec camera = in.scene.camera ? *in.scene.camera : volume::fit_camera(in.volume, CameraSpec{}.width, CameraSpec{}.height);
-        if (opt->width != -1) camera.width = opt->width;
-        if (opt->height != -1) camera.height = opt->height;
-        volume::RenderOptions render;
-        render.shading = opt->shading == "phong" ? volume::Shading::Phong : volume::Shading::None;
-        const volume::RayCaster caster(in.volume, *in.tf, camera, render);
-
-        sampling::FeatureGeometry geometry;
-        if (!trade.features.classes.is_empty())
-          geometry = opt->feature_mesh.empty()
-                         ? isosurface::build_feature_geometry(in.volume, *in.tf, feature_options(camera, trade))
-                         : isosurface::load_feature_geometry(opt->feature_mesh, &in.volume);
-        sampling::TradeResult result =
-            sampling::run_trade(caster, trade.features.classes.is_empty() ? nullptr : &geometry, trade);
-        const std::vector<sampling::TradeRow> knobs = sampling::run_render_knobs(
-            in.volume, *in.tf, camera, render, opt->steps, opt->early_terminations, result, trade);
-        result.rows.insert(result.rows.end(), knobs.begin(), knobs.end());
-        const std::string csv = sampling::trade_csv(result.rows);
-        write_text(opt->out, csv);
-        if (!common.quiet) std::cout << csv;
-        if (!opt->plot.empty())
-          write_plot(opt->out, opt->plot,
-                     opt->scene + " " + std::to_string(camera.width) + "x" + std::to_string(camera.height));
-        Json stats = {{"rows", result.rows.size()},
-                      {"width", camera.width},
-                      {"height", camera.height},
-                      {"features_setup_ms", geometry.build_ms},
-                      {"feature_triangles", geometry.mesh.triangles.size()}};
-        write_stats_if_requested(common, stats);
-      };
+      return [opt, &common] { run(*opt, common); };
     },
     false);
 

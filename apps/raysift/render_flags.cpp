@@ -7,7 +7,6 @@
 #include "apps/raysift/cli_checks.h"
 #include "apps/raysift/guard_flags.h"
 #include "apps/raysift/sampling_flags.h"
-#include "apps/raysift/volume_input.h"
 #include "core/file_util.h"
 #include "core/memory_limit.h"
 #include "core/scene.h"
@@ -56,12 +55,9 @@ void check_path_flags(PathCliOptions& p, RenderCliOptions& o) {
 }  // namespace
 
 void add_render_options(CLI::App& sub, RenderCliOptions& o, PathCliOptions& p, const std::vector<std::string>& mode_names) {
-  sub.add_option("VOLUME", o.volume, "input .vdb (default: the scene's volume)");
+  add_volume_flags(sub, o.input, "transfer function JSON (ParaView preset or {\"points\": ...})");
   sub.add_option("-o,--out", o.out, "output image: .exr (linear RGB + alpha = opacity) or .png (sRGB, opaque)")
       ->required()->check(has_extension({".exr", ".png"}));
-  sub.add_option("--grid", o.grid, "grid name (default: the scene's, else the first float grid)");
-  sub.add_option("--tf", o.tf, "transfer function JSON (ParaView preset or {\"points\": ...})");
-  sub.add_flag("--tf-normalized", o.tf_normalized, "TF x values are 0..1 over the data range");
   sub.add_option("--camera", o.camera, "camera JSON (default: the scene's, else fitted to the volume)");
   sub.add_option("--width", o.width, "image width in pixels (default: camera's, else " +
                                             std::to_string(CameraSpec{}.width) + ")")->check(image_side());
@@ -82,7 +78,8 @@ void add_render_options(CLI::App& sub, RenderCliOptions& o, PathCliOptions& p, c
       ->check(number_in(0, 1, End::Open))->capture_default_str();
   caster->add_flag("--no-skip", o.no_skip, "disable empty-space skipping (same image, slower)");
   caster->add_flag("--jitter", o.jitter, "random start offset per ray (from --seed)");
-  caster->add_option("--pixel", o.pixel, "debug: trace only pixel x,y serially and print it (no image written)");
+  caster->add_option("--pixel", o.pixel, "debug: trace only pixel x,y serially and print it (no image written)")
+      ->delimiter(',')->expected(2)->check(CLI::NonNegativeNumber);
   auto* sampled = sub.add_option_group("Sampled modes (prioritized, subsample)");
   sampled->add_option("--ray-fraction", o.ray_fraction,
                  "prioritized/subsample: rays as a fraction of the full render's")
@@ -139,8 +136,7 @@ std::uint64_t render_bytes(const RenderCliOptions& o, const CameraSpec& camera) 
 }
 
 RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common) {
-  VolumeInput input = load_volume_input(o.volume, o.grid, o.tf, o.tf_normalized, common.scene_path, common, "render",
-                                        volume::EmptyGrid::Allow);
+  VolumeInput input = load_volume_input(o.input, common.scene_path, common, "render", volume::EmptyGrid::Allow);
   if (!input.tf) throw UsageError("render needs --tf TF.json or a --scene with a 'transfer_function'; see --help");
   const Scene& scene = input.scene;
   const volume::GridInfo& info = input.info;
@@ -211,8 +207,8 @@ RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common
 
 std::string echo_command(const RenderCliOptions& o, const RenderInputs& in, const CommonOptions& common) {
   std::ostringstream s;
-  s << "raysift render " << (o.volume.empty() ? "--scene " + common.scene_path : o.volume);
-  if (!o.tf.empty()) s << " --tf " << o.tf;
+  s << "raysift render " << (o.input.volume.empty() ? "--scene " + common.scene_path : o.input.volume);
+  if (!o.input.tf.empty()) s << " --tf " << o.input.tf;
   if (!o.camera.empty()) s << " --camera " << o.camera;
   s << " --width " << in.camera.width << " --height " << in.camera.height << " --mode " << o.mode << " --step "
     << o.step << " --shading " << o.shading << (o.light_dir.empty() ? "" : " --light-dir " + join(o.light_dir))

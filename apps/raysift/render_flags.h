@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "apps/raysift/command.h"
+#include "apps/raysift/volume_input.h"
 #include "isosurface/feature_cache.h"
 #include "sampling/volume_sampling.h"
 #include "volume/raycaster.h"
@@ -16,7 +17,8 @@
 namespace raysift::app {
 
 struct RenderCliOptions {
-  std::string volume, grid, tf, camera, out;
+  VolumeFlags input;  ///< VOLUME, --grid, --tf, --tf-normalized
+  std::string camera, out;
   std::string mode = "full";
   int width = -1, height = -1;  ///< -1 = from the camera file / scene / 512
   double step = volume::RenderOptions{}.step_voxels;
@@ -24,8 +26,8 @@ struct RenderCliOptions {
   std::vector<double> background{0, 0, 0};  ///< linear R,G,B
   std::vector<double> light_dir;            ///< X,Y,Z; empty = headlight
   double early_termination = volume::RenderOptions{}.early_termination;
-  bool no_skip = false, jitter = false, tf_normalized = false;
-  std::string pixel;  ///< "x,y": trace one pixel serially and print it
+  bool no_skip = false, jitter = false;
+  std::vector<int> pixel;  ///< x,y: trace one pixel serially and print it; empty = render the image
   // Sampled modes (prioritized, subsample): sampling/volume_sampling.h.
   double ray_fraction = sampling::SamplingOptions{}.ray_fraction;
   double budget_ms = 0;

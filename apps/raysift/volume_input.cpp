@@ -9,35 +9,41 @@
 
 namespace raysift::app {
 
-VolumeInput load_volume_input(const std::string& volume_arg, const std::string& grid, const std::string& tf_path,
-                              bool tf_normalized, const std::string& scene_path, const CommonOptions& common,
-                              const std::string& command,
-                              volume::EmptyGrid empty) {
+void add_volume_flags(CLI::App& sub, VolumeFlags& flags, const std::string& tf_help, bool positional) {
+  if (positional) sub.add_option("VOLUME", flags.volume, "input .vdb (default: the scene's volume)");
+  sub.add_option("--grid", flags.grid, "grid name (default: the scene's, else the first non-empty float grid)");
+  sub.add_option("--tf", flags.tf, tf_help);
+  sub.add_flag("--tf-normalized", flags.tf_normalized, "TF x values are 0..1 over the data range");
+}
+
+VolumeInput load_volume_input(const VolumeFlags& flags, const std::string& scene_path, const CommonOptions& common,
+                              const std::string& command, volume::EmptyGrid empty) {
   VolumeInput in;
   if (!scene_path.empty()) in.scene = load_scene(scene_path);
-  in.volume_path = !volume_arg.empty() ? volume_arg : in.scene.volume;
+  in.volume_path = !flags.volume.empty() ? flags.volume : in.scene.volume;
   if (in.volume_path.empty())
     throw UsageError(command + " needs a VOLUME argument or a --scene with a 'volume'; see --help");
   volume::LoadVdbOptions load;
   load.empty = empty;
   load.non_finite = non_finite_policy(common);
-  in.volume = volume::load_vdb(in.volume_path, !grid.empty() ? grid : in.scene.grid, load, &in.non_finite_voxels);
+  const std::string& grid = !flags.grid.empty() ? flags.grid : in.scene.grid;
+  in.volume = volume::load_vdb(in.volume_path, grid, load, &in.non_finite_voxels);
   if (in.non_finite_voxels > 0 && !common.quiet)
     std::cerr << "raysift: warning: " << in.volume_path << ": " << in.non_finite_voxels << " NaN/Inf voxels loaded with --non-finite "
               << common.non_finite << "\n";
   in.info = in.volume.info();
 
   volume::TfJsonOptions tf_options;
-  tf_options.normalized = tf_normalized;
+  tf_options.normalized = flags.tf_normalized;
   tf_options.data_min = in.info.value_min;
   tf_options.data_max = in.info.value_max;
   if (tf_options.data_min == tf_options.data_max) {  // a constant solid: normalise over it and the background
     tf_options.data_min = std::min(in.info.value_min, in.info.background);
     tf_options.data_max = std::max(in.info.value_max, in.info.background);
   }
-  if (!tf_path.empty()) {
-    in.tf_source = tf_path;
-    in.tf = std::make_unique<volume::TransferFunction>(volume::load_transfer_function(tf_path, tf_options));
+  if (!flags.tf.empty()) {
+    in.tf_source = flags.tf;
+    in.tf = std::make_unique<volume::TransferFunction>(volume::load_transfer_function(flags.tf, tf_options));
   } else if (!in.scene.transfer_function.is_null()) {
     in.tf_source = in.scene.transfer_function_source;
     in.tf = std::make_unique<volume::TransferFunction>(

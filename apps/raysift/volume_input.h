@@ -1,6 +1,7 @@
 #pragma once
-/// \file The volume + transfer-function input that `mesh` and `render` share: the positional VOLUME, --grid,
-/// --tf and --tf-normalized, each falling back to the --scene's fields.
+/// \file The volume + transfer-function input that `render`, `mesh`, `sweep` and `demo` share: the positional
+/// VOLUME, --grid, --tf and --tf-normalized, each falling back to the --scene's fields.
+#include <CLI/CLI.hpp>
 #include <memory>
 #include <string>
 
@@ -12,6 +13,16 @@
 
 namespace raysift::app {
 
+/// The flags' values; empty = the scene's.
+struct VolumeFlags {
+  std::string volume, grid, tf;
+  bool tf_normalized = false;
+};
+
+/// Adds VOLUME (unless `positional` is false: the volume then comes from the scene), --grid, --tf with
+/// `tf_help` (what the TF is for) and --tf-normalized.
+void add_volume_flags(CLI::App& sub, VolumeFlags& flags, const std::string& tf_help, bool positional = true);
+
 struct VolumeInput {
   Scene scene;                                  ///< empty when no --scene was given
   std::string volume_path;                      ///< the file the volume came from, for messages
@@ -22,13 +33,12 @@ struct VolumeInput {
   std::uint64_t non_finite_voxels = 0;          ///< NaN/Inf voxels that --non-finite replaced
 };
 
-/// Loads the volume (flag, else the scene file's at `scene_path`, "" for none) and the TF (--tf, else the scene's; normalised ranges map to the
-/// grid's value range). NaN/Inf voxels follow --non-finite (a warning names their count unless --quiet).
-/// `empty` = Allow lets a grid without active voxels through (render shows the background).
+/// Loads the volume (flag, else the scene file's at `scene_path`, "" for none) and the TF (--tf, else the
+/// scene's; normalised ranges map to the grid's value range). NaN/Inf voxels follow --non-finite (a warning
+/// names their count unless --quiet). `empty` = Allow lets a grid without active voxels through (render
+/// shows the background).
 /// \throw UsageError naming `command` when no volume is given; IoError/InvalidInput for unreadable files.
-VolumeInput load_volume_input(const std::string& volume_arg, const std::string& grid, const std::string& tf_path,
-                              bool tf_normalized, const std::string& scene_path, const CommonOptions& common,
-                              const std::string& command,
-                              volume::EmptyGrid empty = volume::EmptyGrid::Reject);
+VolumeInput load_volume_input(const VolumeFlags& flags, const std::string& scene_path, const CommonOptions& common,
+                              const std::string& command, volume::EmptyGrid empty = volume::EmptyGrid::Reject);
 
 }  // namespace raysift::app

@@ -2,13 +2,13 @@
 /// \file Internal: visits the pixels near 2D segments tile by tile, for the importance buffer and the line
 /// picture. Within a tile segments are visited in input order, so order-dependent blending is
 /// deterministic; tiles are independent, so they run in parallel without locks.
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
+
+#include "core/parallel.h"
 
 namespace raysift::features::detail {
 
@@ -61,14 +61,7 @@ void for_each_pixel_near_segments(int width, int height, const std::vector<Segme
         }
     }
   };
-  if (threaded) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, bins.size(), 1),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t t = r.begin(); t != r.end(); ++t) run_tile(t);
-                      });
-  } else {
-    for (std::size_t t = 0; t < bins.size(); ++t) run_tile(t);
-  }
+  parallel_for_each(bins.size(), run_tile, threaded);
 }
 
 }  // namespace raysift::features::detail

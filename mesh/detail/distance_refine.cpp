@@ -1,12 +1,10 @@
 #include "mesh/detail/distance_refine.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <utility>
 
+#include "core/parallel.h"
 
 namespace raysift::mesh::detail {
 
@@ -21,9 +19,7 @@ constexpr double kSteps[3] = {1.0, 0.5, 0.25};
 /// fn(i) for i in [0, n) in parallel; each i writes only its own slot, so any thread count gives the same result.
 template <typename Fn>
 void for_each_index(std::size_t n, const Fn& fn) {
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t i = r.begin(); i < r.end(); ++i) fn(i);
-  });
+  parallel_for_each(n, fn, true, std::size_t(256));
 }
 
 class Refiner {

@@ -75,7 +75,7 @@ void expect_usage_errors(const std::string& tag, const std::vector<BadFlag>& cas
     EXPECT_EQ(r[i].code, 2) << args[i] << "\n" << r[i].err;
     EXPECT_NE(r[i].err.find(cases[i].flag), std::string::npos) << args[i] << "\n" << r[i].err;
   }
-  for (const char* out : {"out.exr", "out.png", "out.jpg"}) EXPECT_FALSE(fs::exists(dir + "/" + out)) << out;
+  for (const char* out : {"out.exr", "out.png", "out.jpg", "out.vdb"}) EXPECT_FALSE(fs::exists(dir + "/" + out)) << out;
 }
 
 TEST(CliUsage, RenderValidatorsNameTheFlag) {
@@ -94,6 +94,10 @@ TEST(CliUsage, RenderValidatorsNameTheFlag) {
                                               {r + "--shading toon", "--shading"},
                                               {r + "--interpolation nearest", "--interpolation"},
                                               {r + "--target-fps 30", "--camera-path"},
+                                              {r + "--pixel 3", "--pixel"},
+                                              {r + "--pixel -1,2", "--pixel"},
+                                              {r + "--pixel 1,x", "--pixel"},
+                                              {r + "--pixel 8,0", "--pixel"},  // outside the 8x8 image
                                           });
 }
 
@@ -126,6 +130,12 @@ TEST(CliUsage, NrrValidatorsNameTheFlag) {
                                            {"nrr b4.ply --view-region disc --eyes 0,0,5 --target 0,0,0", "--view-region"},
                                            {"nrr b4.ply --view-region segment --eyes \"0,0,5;1,0\" --target 0,0,0",
                                             "--eyes"},
+                                           {"nrr b4.ply --view-region segment --eyes \"0,0,5;1,0,nan\" --target 0,0,0",
+                                            "--eyes"},
+                                           {"nrr b4.ply --view-region segment --eyes \"0,0,5;1;0;5\" --target 0,0,0",
+                                            "--eyes"},
+                                           {"nrr b4.ply --view-region segment --eyes \"0,0,5;1,0,5;2,0,5\" --target 0,0,0",
+                                            "--eyes"},  // three eyes for a segment
                                        });
 }
 
@@ -139,6 +149,11 @@ TEST(CliUsage, LinesInfoAndDemoValidatorsNameTheFlag) {
                                              {l + "--sug-thresh -1", "--sug-thresh"},
                                              {l + "--svg out.txt", "--svg"},
                                              {l + "--height -1", "--height"},
+                                             {l + "--priority contours", "--priority"},
+                                             {l + "--priority contours=1.5", "--priority"},
+                                             {l + "--priority ridges=0.3,spirals=1", "--priority"},
+                                             {l + "--priority valleys=0.5x", "--priority"},
+                                             {l + "--features contours,spirals", "--features"},
                                              {"info x.vdb --bins 0", "--bins"},
                                              {"demo -o out.png --time-fraction 0", "--time-fraction"},
                                              {"demo -o out.png --repeats 0", "--repeats"},
@@ -162,6 +177,8 @@ TEST(CliUsage, MeshImportAndImageValidatorsNameTheFlag) {
                                              {"saliency a.png -o out.png --scale 1.5", "--scale"},
                                              {"compare a.png b.png --ppd 0", "--ppd"},
                                              {"make-scene forest -o out.ply", "KIND"},
+                                             {"make-volume forest -o out.vdb", "KIND"},
+                                             {"make-volume ball --sigma 2 -o out.vdb", "--sigma"},
                                          });
 }
 

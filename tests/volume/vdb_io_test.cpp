@@ -116,6 +116,19 @@ TEST(VdbIo, DefaultGridIsTheFirstNonEmptyFloatGrid) {
   EXPECT_EQ(default_grid_name({labels}), "");
 }
 
+TEST(VdbIo, ActiveWorldBoxSpansTheVoxelsOfTheFloatGrid) {
+  // 'density' has active voxels (2,3,4) .. (5,6,7) at voxel size 0.5: centres 1..2.5 etc., grown by a quarter.
+  const std::optional<Bbox3d> box = active_world_box(kMixed);
+  ASSERT_TRUE(box.has_value());
+  EXPECT_EQ(box->min, Vec3d(0.75, 1.25, 1.75));
+  EXPECT_EQ(box->max, Vec3d(2.75, 3.25, 3.75));
+  EXPECT_EQ(active_world_box(kMixed, "density")->max, box->max);
+  EXPECT_FALSE(active_world_box(kMixed, "velocity").has_value());  // not a float grid
+  EXPECT_FALSE(active_world_box(kMixed, "empty").has_value());     // no active voxels
+  EXPECT_FALSE(active_world_box(kMixed, "pressure").has_value());  // no such grid
+  EXPECT_THROW(active_world_box(test::make_temp_dir("vdb_box") + "/missing.vdb"), IoError);
+}
+
 TEST(VdbIo, NonFloatGridNamesItsType) {
   const std::string msg = message_of<InvalidInput>([&] { load_vdb(kMixed, "labels"); });
   EXPECT_NE(msg.find("int32"), std::string::npos) << msg;

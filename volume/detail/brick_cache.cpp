@@ -1,12 +1,11 @@
 #include "volume/detail/brick_cache.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
+
+#include "core/parallel.h"
 
 namespace raysift::volume {
 
@@ -61,9 +60,9 @@ VolumeBricks build_volume_bricks_from_grid(const openvdb::FloatGrid& grid) {
   out.hi.resize(count);
 
   auto for_each_block = [&](auto&& body) {
-    tbb::parallel_for(tbb::blocked_range<int>(0, out.dims.z), [&](const tbb::blocked_range<int>& r) {
-      openvdb::tree::ValueAccessor<const Tree, false> acc(grid.tree());
-      for (int k = r.begin(); k < r.end(); ++k)
+    parallel_ranges(out.dims.z, [&](int k_begin, int k_end) {
+      openvdb::tree::ValueAccessor<const Tree, false> acc(grid.tree());  // one per chunk: not thread-safe
+      for (int k = k_begin; k < k_end; ++k)
         for (int j = 0; j < out.dims.y; ++j)
           for (int i = 0; i < out.dims.x; ++i)
             body(acc, openvdb::Coord((bmin.x + i) * kBlockSize, (bmin.y + j) * kBlockSize, (bmin.z + k) * kBlockSize),
