@@ -257,6 +257,15 @@ class Refiner {
 
   std::size_t waiting() const { return queue_.size(); }
 
+  // 1 on background and traced pixels.
+  void known_mask(ImageMask& out) const {
+    out = ImageMask(imp_.width, imp_.height, 0);
+    parallel_rows(imp_.height, [&](int y) {
+      const std::size_t row = std::size_t(y) * std::size_t(imp_.width);
+      for (std::size_t i = row; i < row + std::size_t(imp_.width); ++i) out.pixels[i] = state_.pixels[i] & kKnown;
+    });
+  }
+
  private:
   // A traced pixel's values as the contrast sees them: RGB through a square root (close to sRGB), alpha,
   // quantised to 1/255 (finer than any floor worth setting).
@@ -421,7 +430,7 @@ std::size_t round_size(const RefinementStop& stop, std::size_t done, double rays
 
 RefinementResult trace_refined(const ImageF& importance, const FractalPattern& pattern,
                                const RefinementOptions& options, const RefinementStop& stop, std::uint64_t seed,
-                               const TraceBatch& trace, ImageRGBA& image, ImageMask& traced) {
+                               const TraceBatch& trace, ImageRGBA& image, ImageMask& traced, ImageMask* known) {
   const int w = importance.width, h = importance.height;
   std::vector<std::uint32_t> level0;
   for (int y = 0; y < h; y += pattern.base_spacing)
@@ -467,6 +476,7 @@ RefinementResult trace_refined(const ImageF& importance, const FractalPattern& p
     result.rays += batch.size();
     if (last) break;
   }
+  if (known) refiner.known_mask(*known);
   return result;
 }
 
