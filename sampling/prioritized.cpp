@@ -120,7 +120,7 @@ void trace_budgeted_queue(const ImageF& importance, const FractalPattern& patter
 // and counted as trace time.
 void trace_refined_frame(const ImageF& importance, const FractalPattern& pattern, const SamplingOptions& options,
                          const TraceBatch& trace, std::size_t target, const ElapsedMs& now,
-                         double elapsed_before_ms, SampledFrame& frame, Timer& stage) {
+                         double elapsed_before_ms, SampledFrame& frame, Timer& stage, ImageMask& known) {
   RefinementStop stop;
   stop.rays = target;
   if (options.budget_ms > 0) {
@@ -131,7 +131,8 @@ void trace_refined_frame(const ImageF& importance, const FractalPattern& pattern
   frame.priorities_ms = stage.elapsed_ms();
   stage.reset();
   const RefinementResult r =
-      trace_refined(importance, pattern, options.refinement, stop, options.seed, trace, frame.image, frame.traced);
+      trace_refined(importance, pattern, options.refinement, stop, options.seed, trace, frame.image, frame.traced,
+                    &known);
   frame.trace_ms = stage.elapsed_ms();
   frame.rays_traced = r.rays;
   frame.budget_too_small = r.level0_overran;
@@ -234,8 +235,9 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
   }
 
   const FractalPattern pattern = make_fractal_pattern(w, h, options.base_spacing);
+  ImageMask known;  // background and traced pixels: the refinement gives it, the other paths build it after tracing
   if (options.refinement.enabled && !std::isfinite(options.threshold)) {
-    trace_refined_frame(importance, pattern, options, trace, target, now, elapsed_before_ms, frame, stage);
+    trace_refined_frame(importance, pattern, options, trace, target, now, elapsed_before_ms, frame, stage, known);
   } else if (options.budget_ms > 0) {
     trace_budgeted_queue(importance, pattern, options, trace, now, elapsed_before_ms, frame, stage);
   } else {
@@ -249,7 +251,7 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
   frame.trace_end_ms = clock.elapsed_ms();
   stage.reset();
   if (frame.rays_traced < counts.object) {
-    const ImageMask known = background_known(importance, &frame.traced);
+    if (known.pixels.empty()) known = background_known(importance, &frame.traced);
     reconstruct_fractal(frame.image, known, pattern, options.interpolation, options.guide);
   }
   frame.reconstruct_ms = stage.elapsed_ms();

@@ -177,7 +177,7 @@ class Refiner {
         state_(frame_buffer<std::uint8_t>(importance.width, importance.height)), queue_(seed) {
     // One pass per row of S x S blocks: the state mask and which blocks hold background.
     const int s = pattern_.base_spacing, bw = (imp_.width + s - 1) / s, bh = (imp_.height + s - 1) / s;
-    Image<std::uint8_t> has_background(bw, bh, 0);
+    Image<std::uint8_t> has_background(bw, bh, 0), has_object(bw, bh, 0);
     parallel_rows(bh, [&](int by) {
       for (int y = by * s; y < std::min(imp_.height, (by + 1) * s); ++y) {
         const std::size_t row = std::size_t(y) * std::size_t(imp_.width);
@@ -185,23 +185,26 @@ class Refiner {
           const std::size_t i = row + std::size_t(x);
           const bool background = imp_.pixels[i] < 0;
           state_.pixels[i] = background ? kKnown | kBackground : traced_.pixels[i] ? kKnown : 0;
-          if (background) has_background(x / s, by) = 1;
+          (background ? has_background : has_object)(x / s, by) = 1;
         }
       }
     });
     mark_open_blocks(has_background);
+    // Orphans are object pixels: open blocks of pure background (most of them, around a compact object) hold none.
+    orphan_blocks_ = open_;
+    for (std::size_t b = 0; b < orphan_blocks_.size(); ++b) orphan_blocks_.pixels[b] &= has_object.pixels[b];
     for (int l = 0; l < int(level_share_.size()); ++l) level_share_[l] = std::ldexp(1.0f, -l);
   }
 
   // Candidates no traced parent will offer: every in-image parent is background.
-  // Their parents lie within S/2, so only open blocks (see mark_open_blocks) can hold them.
+  // Their parents lie within S/2, so only open blocks (see mark_open_blocks) with object pixels can hold them.
   void offer_orphans() {
     push(gather(std::size_t(imp_.height), 16, [this](std::size_t y0, std::size_t y1, std::vector<Candidate>& out) {
       std::vector<Ready> ready;
       const int s = pattern_.base_spacing;
       for (int y = int(y0); y < int(y1); ++y)
         for (int x = 0; x < imp_.width; ++x) {
-          if (!open_(x / s, y / s)) {
+          if (!orphan_blocks_(x / s, y / s)) {
             x += s - 1 - x % s;  // the rest of this block's row
             continue;
           }
@@ -246,6 +249,15 @@ class Refiner {
   }
 
   std::size_t waiting() const { return queue_.size(); }
+
+  // 1 on background and traced pixels.
+  void known_mask(ImageMask& out) const {
+    out = ImageMask(imp_.width, imp_.height, 0);
+    parallel_rows(imp_.height, [&](int y) {
+      const std::size_t row = std::size_t(y) * std::size_t(imp_.width);
+      for (std::size_t i = row; i < row + std::size_t(imp_.width); ++i) out.pixels[i] = state_.pixels[i] & kKnown;
+    });
+  }
 
  private:
   // A traced pixel's values as the contrast sees them: RGB through a square root (close to sRGB), alpha,
@@ -372,6 +384,7 @@ class Refiner {
   ImageMask& state_;  ///< kKnown: background or traced (kBackground: background); kTaken: popped for tracing
   BucketQueue queue_;
   Image<std::uint8_t> open_;  ///< per S x S block, see mark_open_blocks()
+  Image<std::uint8_t> orphan_blocks_;  ///< open blocks holding an object pixel: where offer_orphans() looks
   std::array<float, 16> level_share_;  ///< 2^-level, the share of the frame one ray of a level covers
 };
 
@@ -411,7 +424,7 @@ std::size_t round_size(const RefinementStop& stop, std::size_t done, double rays
 
 RefinementResult trace_refined(const ImageF& importance, const FractalPattern& pattern,
                                const RefinementOptions& options, const RefinementStop& stop, std::uint64_t seed,
-                               const TraceBatch& trace, ImageRGBA& image, ImageMask& traced) {
+                               const TraceBatch& trace, ImageRGBA& image, ImageMask& traced, ImageMask* known) {
   const int w = importance.width, h = importance.height;
   std::vector<std::uint32_t> level0;
   for (int y = 0; y < h; y += pattern.base_spacing)
@@ -457,6 +470,7 @@ RefinementResult trace_refined(const ImageF& importance, const FractalPattern& p
     result.rays += batch.size();
     if (last) break;
   }
+  if (known) refiner.known_mask(*known);
   return result;
 }
 

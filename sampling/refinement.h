@@ -41,8 +41,10 @@ struct RefinementResult {
 /// \param image receives the traced values; \param traced is set to 1 on traced pixels
 /// With a ray-count stop the result is the same for any thread count (rounds and ties are fixed by the
 /// samples and `seed`); a deadline cuts wherever the clock says.
+/// \param known if not null, receives 1 on background and traced pixels (what the reconstruction keeps), from the
+///        refiner's own state instead of another pass over the importance
 RefinementResult trace_refined(const ImageF& importance, const FractalPattern& pattern, const RefinementOptions& options,
                                const RefinementStop& stop, std::uint64_t seed, const TraceBatch& trace,
-                               ImageRGBA& image, ImageMask& traced);
+                               ImageRGBA& image, ImageMask& traced, ImageMask* known = nullptr);
 
 }  // namespace raysift::sampling

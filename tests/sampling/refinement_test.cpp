@@ -177,5 +177,31 @@ TEST(Refinement, BudgetStopsLaunchingAtTheDeadlineOnAVirtualClock) {
   EXPECT_EQ(tiny.rays_traced, tiny.level0_rays);
 }
 
+TEST(Refinement, KnownMaskIsBackgroundOrTracedAlsoWhenADeadlineCutsARound) {
+  // The reconstruction keeps exactly these pixels; a round cut by the deadline leaves popped pixels untraced.
+  const ImageF imp = disc();
+  const FractalPattern p = make_fractal_pattern(kW, kH, 8);
+  std::atomic<std::int64_t> clock_us{0};
+  const ElapsedMs now = [&clock_us] { return double(clock_us.load()) / 1000.0; };
+  RefinementStop by_count, by_clock;
+  by_count.rays = 700;
+  by_clock.deadline_ms = 5.05;  // inside a round: level 0 is ~0.4 ms, the first round alone ~2.5 ms
+  by_clock.now = &now;
+  for (const RefinementStop& stop : {by_count, by_clock}) {
+    ImageRGBA image(kW, kH);
+    ImageMask traced(kW, kH, 0), known;
+    trace_refined(imp, p, {}, stop, 1, tracer(step_edge, nullptr, &clock_us), image, traced, &known);
+    ASSERT_EQ(known.width, kW);
+    ASSERT_EQ(known.height, kH);
+    std::size_t n_traced = 0;
+    for (std::size_t i = 0; i < known.size(); ++i) {
+      ASSERT_EQ(known.pixels[i], imp.pixels[i] < 0 || traced.pixels[i] ? 1 : 0) << "pixel " << i;
+      n_traced += traced.pixels[i];
+    }
+    EXPECT_GT(n_traced, 0u);
+    EXPECT_LT(n_traced, object_pixels(imp));
+  }
+}
+
 }  // namespace
 }  // namespace raysift::sampling
