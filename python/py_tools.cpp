@@ -2,11 +2,11 @@
 #include <optional>
 #include <sstream>
 
+#include "apps/raysift/stats_json.h"
 #include "core/errors.h"
 #include "core/image.h"
 #include "features/lines_pipeline.h"
 #include "isosurface/pipeline.h"
-#include "mesh/mesh_analysis.h"
 #include "python/py_bindings.h"
 #include "python/py_common.h"
 #include "sampling/metrics.h"
@@ -50,35 +50,13 @@ pyb::object compare(const FloatArray& reference, const FloatArray& test, const s
   return to_python(stats);
 }
 
-// `raysift mesh --stats`: duplicates of cmd_mesh.cpp's private surface_json and stages_json.
-Json surface_json(const TriMesh& m) {
-  if (m.empty()) return {{"triangles", 0}, {"vertices", 0}, {"watertight", false}, {"euler_characteristic", 0}, {"area", 0.0}};
-  const mesh::MeshAnalysis a = mesh::analyze_mesh(m);
-  Json s = {{"triangles", a.faces},
-            {"vertices", a.vertices},
-            {"watertight", a.is_watertight()},
-            {"euler_characteristic", a.euler_characteristic},
-            {"area", a.area}};
-  if (a.is_watertight()) s["enclosed_volume"] = a.signed_volume;
-  return s;
-}
-
-Json stage_json(const mesh::StageReport& s) { return {{"ms", s.ms}, {"triangles", s.triangles}}; }
-
 Json mesh_stats(const isosurface::IsosurfaceSet& set) {
   Json iso = Json::array(), surfaces = Json::array();
   for (const isosurface::Surface& s : set.surfaces) {
     iso.push_back(s.iso.value);
-    surfaces.push_back(surface_json(s.mesh));
+    surfaces.push_back(app::surface_json(s.mesh));
   }
-  const isosurface::StageTimes& t = set.stages;
-  return {{"iso_values", iso},
-          {"surfaces", surfaces},
-          {"stages",
-           {{"marching_cubes", stage_json(t.marching_cubes)},
-            {"smooth_before", stage_json(t.smooth_before)},
-            {"decimate", stage_json(t.decimate)},
-            {"smooth_after", stage_json(t.smooth_after)}}}};
+  return {{"iso_values", iso}, {"surfaces", surfaces}, {"stages", app::stages_json(set.stages)}};
 }
 
 /// `raysift mesh VOLUME --tf TF [--iso V,...] --smooth S --decimate R`: (vertices, faces, stats).

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "apps/raysift/stats_json.h"
 #include "core/camera.h"
 #include "core/parallel.h"
 #include "core/errors.h"
@@ -93,24 +94,6 @@ pyb::array_t<float> to_numpy(const Volume& v) {
   return owning_array(std::move(values), data, {n.z, n.y, n.x});
 }
 
-Json vec3i_json(const Vec3i& v) { return Json::array({v.x, v.y, v.z}); }
-
-/// The keys of one grid in `raysift info --stats` (a duplicate of cmd_info.cpp's private grid_json).
-Json grid_json(const volume::GridInfo& g) {
-  return {{"name", g.name},
-          {"type", g.type},
-          {"class", g.grid_class},
-          {"active_voxels", g.active_voxels},
-          {"index_min", vec3i_json(g.index_min)},
-          {"index_max", vec3i_json(g.index_max)},
-          {"bbox_min", vec3_to_json(g.bbox_min)},
-          {"bbox_max", vec3_to_json(g.bbox_max)},
-          {"voxel_size", vec3_to_json(g.voxel_size)},
-          {"value_min", g.value_min},
-          {"value_max", g.value_max},
-          {"background", g.background}};
-}
-
 pyb::dict histogram(const Volume& v, int bins) {
   if (bins < 1) throw InvalidInput("histogram: bins must be >= 1, got " + std::to_string(bins));
   volume::Histogram h = run_released([&](const std::atomic<bool>&) { return volume::compute_histogram(v, bins); });
@@ -139,7 +122,7 @@ void bind_volume(pyb::module_& m) {
              run_released([&](const std::atomic<bool>&) { volume::save_vdb(path, v); });
            },
            pyb::arg("path"))
-      .def("info", [](const Volume& v) { return to_python(grid_json(v.info())); })
+      .def("info", [](const Volume& v) { return to_python(app::grid_info_json(v.info())); })
       .def("histogram", &histogram, pyb::arg("bins") = 256)
       .def("to_numpy", &to_numpy)
       .def_property_readonly("name", &Volume::name)

@@ -15,7 +15,9 @@ packages=(cmake g++ make pkg-config ccache zlib1g-dev
   libtbb-dev nlohmann-json3-dev libcli11-dev)
 case "$mode" in
   demo) build_all=OFF ;;
-  test) build_all=ON; packages+=(libgtest-dev libopenvdb-tools openimageio-tools) ;;
+  test) build_all=ON  # + tests, the shell tools they call, and the Python module with its test runner
+        packages+=(libgtest-dev libopenvdb-tools openimageio-tools
+                   pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-openimageio) ;;
   *) echo "usage: scripts/setup.sh demo|test" >&2; exit 2 ;;
 esac
 source scripts/install_missing.sh

@@ -5,6 +5,7 @@
 
 #include "apps/raysift/command.h"
 #include "apps/raysift/guard_flags.h"
+#include "apps/raysift/stats_json.h"
 #include "core/errors.h"
 #include "core/scene.h"
 #include "core/timer.h"
@@ -18,23 +19,6 @@ struct InfoOptions {
   std::string volume, grid;
   int bins = 256;
 };
-
-Json vec3i_to_json(const Vec3i& v) { return Json::array({v.x, v.y, v.z}); }
-
-Json grid_json(const volume::GridInfo& g) {
-  return {{"name", g.name},
-          {"type", g.type},
-          {"class", g.grid_class},
-          {"active_voxels", g.active_voxels},
-          {"index_min", vec3i_to_json(g.index_min)},
-          {"index_max", vec3i_to_json(g.index_max)},
-          {"bbox_min", vec3_to_json(g.bbox_min)},
-          {"bbox_max", vec3_to_json(g.bbox_max)},
-          {"voxel_size", vec3_to_json(g.voxel_size)},
-          {"value_min", g.value_min},
-          {"value_max", g.value_max},
-          {"background", g.background}};
-}
 
 void print_grid(const volume::GridInfo& g) {
   std::printf("  grid '%s'  (%s, %s)\n", g.name.c_str(), g.type.c_str(), g.grid_class.c_str());
@@ -92,7 +76,7 @@ RegisterCommand reg("info", "describe the grids of a .vdb file (bbox, voxel size
                         const std::vector<volume::GridInfo> grids = volume::inspect_vdb(path);
                         const double read_ms = timer.elapsed_ms();
                         Json stats = {{"command", "info"}, {"file", path}, {"grids", Json::array()}};
-                        for (const auto& g : grids) stats["grids"].push_back(grid_json(g));
+                        for (const auto& g : grids) stats["grids"].push_back(grid_info_json(g));
                         // Files with no float grid still get their grid list, without a histogram.
                         if (grid.empty()) grid = volume::default_grid_name(grids);
                         volume::Histogram hist;

@@ -8,12 +8,12 @@
 #include "apps/raysift/command.h"
 #include "apps/raysift/guard_flags.h"
 #include "apps/raysift/mesh_flags.h"
+#include "apps/raysift/stats_json.h"
 #include "apps/raysift/volume_input.h"
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/progress.h"
 #include "core/signals.h"
-#include "mesh/mesh_analysis.h"
 #include "mesh/mesh_io.h"
 
 namespace raysift::app {
@@ -32,27 +32,6 @@ std::vector<double> given_iso_values(const std::vector<double>& iso, const volum
     }
   }
   return iso;
-}
-
-Json surface_json(const TriMesh& m) {
-  if (m.empty()) return {{"triangles", 0}, {"vertices", 0}, {"watertight", false}, {"euler_characteristic", 0}, {"area", 0.0}};
-  const mesh::MeshAnalysis a = mesh::analyze_mesh(m);
-  Json s = {{"triangles", a.faces},
-            {"vertices", a.vertices},
-            {"watertight", a.is_watertight()},
-            {"euler_characteristic", a.euler_characteristic},
-            {"area", a.area}};
-  if (a.is_watertight()) s["enclosed_volume"] = a.signed_volume;
-  return s;
-}
-
-Json stage_json(const mesh::StageReport& s) { return {{"ms", s.ms}, {"triangles", s.triangles}}; }
-
-Json stages_json(const isosurface::StageTimes& t) {
-  return {{"marching_cubes", stage_json(t.marching_cubes)},
-          {"smooth_before", stage_json(t.smooth_before)},
-          {"decimate", stage_json(t.decimate)},
-          {"smooth_after", stage_json(t.smooth_after)}};
 }
 
 /// Prints each surface's iso-value and its warnings; returns the iso-values and the per-surface stats.
