@@ -5,8 +5,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 # -O1: Debug keeps asserts and DCHECKs, -O1 keeps the suite inside CI's budget (-O0 is several times slower).
+# No Python module: a CPython extension would need libasan preloaded into the interpreter; pytest runs in command (b).
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g -O1" \
-  -DRAYSIFT_SANITIZE=address,undefined -DRAYSIFT_BUILD_BENCH=OFF
+  -DRAYSIFT_SANITIZE=address,undefined -DRAYSIFT_BUILD_BENCH=OFF -DRAYSIFT_PYTHON=OFF
 targets=(core_tests volume_tests mesh_tests isosurface_tests features_tests sampling_tests nrr_tests apps_tests extremes_tests)
 cmake --build build-asan -j2 --target "${targets[@]}"
 
