@@ -36,7 +36,7 @@ std::size_t share_of_total(std::size_t total, std::size_t surface_triangles, std
 /// adds 87 MB (138 B per triangle), smoothing 13 MB (21 B); the factors round those up.
 std::uint64_t preparation_bytes(const std::vector<TriMesh>& raw, const mesh::MeshPrepOptions& prep) {
   constexpr std::uint64_t kDecimationBytesPerTriangle = 160, kSmoothingBytesPerTriangle = 32;
-  const bool decimating = prep.decimation.target_faces > 0 || prep.decimation.ratio < 1.0;
+  const bool decimating = prep.decimation.active();
   const bool smoothing = prep.smooth_before.iterations > 0 || prep.smooth_after.iterations > 0;
   const std::uint64_t per_triangle = decimating ? kDecimationBytesPerTriangle : smoothing ? kSmoothingBytesPerTriangle : 0;
   std::uint64_t bytes = 0;

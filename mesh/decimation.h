@@ -29,6 +29,8 @@ struct DecimationOptions {
   /// (minimax on vertices, edge midpoints and centroids; topology unchanged). Lowers the one-sided Hausdorff
   /// distance output -> input by 14-57 % on the bench's marching-cubes surfaces for 25-45 % more CPU time.
   bool refine_distance = true;
+  /// False when the options leave every face (ratio 1, no face target): the stage is skipped.
+  bool active() const { return target_faces > 0 || ratio < 1.0; }
 };
 
 struct DecimationResult {

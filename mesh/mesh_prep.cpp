@@ -11,7 +11,6 @@ MeshPrepResult prepare_mesh(const TriMesh& mesh, const MeshPrepOptions& options)
   result.smooth_before = {options.smooth_before.iterations > 0 ? timer.elapsed_ms() : 0.0, result.mesh.triangle_count()};
 
   timer.reset();
-  const bool decimating = options.decimation.target_faces > 0 || options.decimation.ratio < 1.0;
   DecimationOptions decimation = options.decimation;
   // Smoothing afterwards sets the distance to the input (measured: the same one-sided Hausdorff with and
   // without the refinement on all four bench surfaces), so its cost would buy nothing.
@@ -19,7 +18,7 @@ MeshPrepResult prepare_mesh(const TriMesh& mesh, const MeshPrepOptions& options)
   DecimationResult decimated = decimate(result.mesh, decimation);
   result.mesh = std::move(decimated.mesh);
   result.decimation_reached_target = decimated.reached_target;
-  result.decimate = {decimating ? timer.elapsed_ms() : 0.0, result.mesh.triangle_count()};
+  result.decimate = {options.decimation.active() ? timer.elapsed_ms() : 0.0, result.mesh.triangle_count()};
 
   timer.reset();
   result.mesh = taubin_smooth(result.mesh, options.smooth_after);

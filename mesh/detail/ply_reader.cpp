@@ -132,7 +132,8 @@ class PlyBody {
  public:
   PlyBody(const std::string& path, const std::string& data, const PlyHeader& header)
       : path_(path), data_(data), pos_(header.body_offset), line_(header.body_first_line),
-        format_(header.format) {}
+        format_(header.format),
+        swap_bytes_((header.format == PlyFormat::binary_big_endian) != host_is_big_endian()) {}
 
   bool ascii() const { return format_ == PlyFormat::ascii; }
   const std::string& path() const { return path_; }
@@ -184,7 +185,7 @@ class PlyBody {
     unsigned char b[8];
     std::memcpy(b, data_.data() + pos_, type.bytes);
     pos_ += type.bytes;
-    if ((format_ == PlyFormat::binary_big_endian) != host_is_big_endian()) std::reverse(b, b + type.bytes);
+    if (swap_bytes_) std::reverse(b, b + type.bytes);
     if (!type.integral) return type.bytes == 4 ? double(load<float>(b)) : load<double>(b);
     switch (type.bytes) {
       case 1: return type.is_signed ? double(std::int8_t(b[0])) : double(b[0]);
@@ -218,6 +219,7 @@ class PlyBody {
   std::size_t pos_;
   int line_;
   PlyFormat format_;
+  bool swap_bytes_;  ///< the file's byte order is not the host's
   const std::string* element_ = nullptr;
   std::uint64_t index_ = 0;
 };
@@ -313,11 +315,12 @@ void skip_element(PlyBody& body, const PlyElement& element) {
 }
 
 std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  if (!in) throw IoError(file_message(path, "could not read the file"));
-  return bytes.str();
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  const std::streamoff size = in ? std::streamoff(in.tellg()) : -1;
+  std::string bytes(std::size_t(std::max<std::streamoff>(size, 0)), '\0');
+  if (size < 0 || !in.seekg(0) || !in.read(bytes.data(), std::streamsize(bytes.size())))
+    throw IoError(file_message(path, "could not read the file"));
+  return bytes;
 }
 
 }  // namespace
