@@ -12,12 +12,15 @@ packages=(cmake g++ make pkg-config ccache zlib1g-dev
   libopenvdb-dev libboost-iostreams-dev
   libopenmesh-dev libmeshoptimizer-dev libembree-dev
   libopenimageio-dev libopencv-core-dev
-  libtbb-dev nlohmann-json3-dev libcli11-dev)
+  libtbb-dev nlohmann-json3-dev libcli11-dev
+  libboost-dev)  # Boost.Beast: raysift serve's HTTP + WebSocket (docs/serve.md)
 case "$mode" in
   demo) build_all=OFF ;;
-  test) build_all=ON  # + tests, the shell tools they call, and the Python module with its test runner
+  test) build_all=ON  # + tests, the shell tools they call, the Python module with its test runner, Open MPI
+                      # (issue 19) and Chromium with a DevTools client for the browser test (issue 18)
         packages+=(libgtest-dev libopenvdb-tools openimageio-tools
-                   pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-openimageio) ;;
+                   pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-openimageio
+                   libopenmpi-dev openmpi-bin chromium python3-websocket) ;;
   *) echo "usage: scripts/setup.sh demo|test" >&2; exit 2 ;;
 esac
 source scripts/install_missing.sh
