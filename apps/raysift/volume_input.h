@@ -33,6 +33,9 @@ struct VolumeInput {
   std::uint64_t non_finite_voxels = 0;          ///< NaN/Inf voxels that --non-finite replaced
 };
 
+/// How a TF file maps onto this grid: --tf-normalized over the data range (a constant grid: with its background).
+volume::TfJsonOptions tf_json_options(const VolumeFlags& flags, const volume::GridInfo& info);
+
 /// Loads the volume (flag, else the scene file's at `scene_path`, "" for none) and the TF (--tf, else the
 /// scene's; normalised ranges map to the grid's value range). NaN/Inf voxels follow --non-finite (a warning
 /// names their count unless --quiet). `empty` = Allow lets a grid without active voxels through (render
