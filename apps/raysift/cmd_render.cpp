@@ -16,6 +16,7 @@
 #include "core/progress.h"
 #include "core/signals.h"
 #include "core/timer.h"
+#include "mpi/session.h"
 
 namespace raysift::app {
 namespace {
@@ -78,6 +79,14 @@ void trace_one_pixel(const std::vector<int>& pixel, const volume::RayCaster& cas
               x, y, r.color.r, r.color.g, r.color.b, r.color.a, c.r, c.g, c.b, r.depth, r.samples);
 }
 
+/// `raysift render` under mpirun with N > 1 ranks: every rank runs this; rank 0 writes.
+void render_distributed(const RenderCliOptions& o, const PathCliOptions& p) {
+  if (!p.camera_path.empty() || !o.pixel.empty())
+    throw UsageError("--camera-path and --pixel run in one process; start them without mpirun (or with -np 1)");
+  throw UsageError("--distribute " + o.distribute + " under mpirun -np " + std::to_string(mpi::size()) +
+                   ": not implemented yet (mpi skeleton)");
+}
+
 RegisterCommand reg(
     "render", "volume ray casting (emission-absorption, transfer function, empty-space skipping)",
     [](CLI::App& sub, CommonOptions& common) -> RunFunction {
@@ -89,6 +98,7 @@ RegisterCommand reg(
       return [opt, path, &common] {
         const Timer total;
         check_render_flags(*path, *opt);
+        if (mpi::size() > 1) return render_distributed(*opt, *path);
         const RenderInputs in = build_inputs(*opt, common);
         if (!path->camera_path.empty()) return render_path(*path, *opt, in, common);
         const volume::RayCaster caster(in.volume, *in.tf, in.camera, in.options);

@@ -12,6 +12,7 @@
 #include "apps/raysift/command.h"
 #include "core/errors.h"
 #include "core/signals.h"
+#include "mpi/session.h"
 
 namespace raysift::app {
 
@@ -21,7 +22,8 @@ std::vector<CommandEntry>& command_registry() {
 }
 
 void write_stats_if_requested(const CommonOptions& common, const Json& stats) {
-  if (!common.stats_path.empty()) write_json_file(common.stats_path, stats);
+  // Rank 0 alone writes (under mpirun every rank runs the command; mpi/session.h).
+  if (!common.stats_path.empty() && mpi::is_root()) write_json_file(common.stats_path, stats);
 }
 
 void bad_flag(const std::string& flag, const std::string& range, const std::string& got) {
@@ -73,6 +75,7 @@ std::string command_list(const CLI::App& cli) {
 int main(int argc, char** argv) {
   using namespace raysift;
   using namespace raysift::app;
+  const mpi::Session mpi_session(&argc, &argv);  // under mpirun: every rank runs the same command
   CLI::App cli{"raysift: prioritized volume ray casting and non-redundant scene discretization", "raysift"};
   cli.set_version_flag("--version", std::string("raysift ") + RAYSIFT_VERSION);
   cli.require_subcommand(0, 1);
@@ -135,16 +138,17 @@ int main(int argc, char** argv) {
     const int threads = common.threads > 0 ? common.threads : tbb::this_task_arena::max_concurrency();
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
     install_cancel_handlers();
-    run();
+    mpi::all_or_none(run);  // with several ranks a failure anywhere fails every rank alike (mpi/session.h)
     return 0;
   } catch (const std::exception& e) {
     if (cancel_signal() == 0) {
-      std::cerr << "raysift: error: " << e.what() << "\n";
-      return dynamic_cast<const UsageError*>(&e) ? 2 : 1;
+      const auto* agreed = dynamic_cast<const mpi::RankFailure*>(&e);
+      if (mpi::is_root()) std::cerr << "raysift: error: " << e.what() << "\n";  // one message, from rank 0
+      return agreed ? agreed->exit_code : dynamic_cast<const UsageError*>(&e) ? 2 : 1;
     }
   }
   // Whatever a signal interrupted failed as a consequence; the staged outputs are gone by now.
-  std::cerr << "raysift: interrupted by " << (cancel_signal() == SIGTERM ? "SIGTERM" : "SIGINT")
+  if (mpi::is_root()) std::cerr << "raysift: interrupted by " << (cancel_signal() == SIGTERM ? "SIGTERM" : "SIGINT")
             << "; no output written\n";
   return 128 + cancel_signal();
 }

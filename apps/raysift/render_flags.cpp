@@ -78,6 +78,10 @@ void add_render_options(CLI::App& sub, RenderCliOptions& o, PathCliOptions& p, c
       ->check(number_in(0, 1, End::Open))->capture_default_str();
   caster->add_flag("--no-skip", o.no_skip, "disable empty-space skipping (same image, slower)");
   caster->add_flag("--jitter", o.jitter, "random start offset per ray (from --seed)");
+  sub.add_option("--distribute", o.distribute,
+                 "under mpirun -np N > 1: data (each rank renders one brick, sort-last compositing), image (tiles "
+                 "dealt to ranks) or auto (data when the volume exceeds one rank's --max-memory, else image)")
+      ->check(CLI::IsMember({"data", "image", "auto"}))->capture_default_str();
   caster->add_option("--pixel", o.pixel, "debug: trace only pixel x,y serially and print it (no image written)")
       ->delimiter(',')->expected(2)->check(CLI::NonNegativeNumber);
   auto* sampled = sub.add_option_group("Sampled modes (prioritized, subsample)");

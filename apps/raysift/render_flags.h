@@ -28,6 +28,10 @@ struct RenderCliOptions {
   double early_termination = volume::RenderOptions{}.early_termination;
   bool no_skip = false, jitter = false;
   std::vector<int> pixel;  ///< x,y: trace one pixel serially and print it; empty = render the image
+  /// Under mpirun with N > 1 ranks (docs/distributed.md): data (sort-last, each rank one brick of the volume),
+  /// image (tiles dealt to ranks) or auto (data when the volume does not fit one rank's --max-memory, else
+  /// image). With one rank the flag changes nothing.
+  std::string distribute = "auto";
   // Sampled modes (prioritized, subsample): sampling/volume_sampling.h.
   double ray_fraction = sampling::SamplingOptions{}.ray_fraction;
   double budget_ms = 0;
