@@ -120,7 +120,7 @@ void assemble(const TileGrid& grid, volume::RenderResult& result, RankStats& sta
     MPI_Probe(source, kTagTileList, MPI_COMM_WORLD, &status);
     int count = 0;
     MPI_Get_count(&status, MPI_INT, &count);
-    std::vector<int> tiles(std::size_t(count));
+    std::vector<int> tiles(static_cast<std::size_t>(count));
     MPI_Recv(tiles.data(), count, MPI_INT, source, kTagTileList, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
     std::size_t floats = 0;
     for (int t : tiles) floats += std::size_t(grid.rect(t).pixels()) * kFloatsPerPixel;

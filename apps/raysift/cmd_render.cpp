@@ -9,6 +9,7 @@
 #include "apps/raysift/command.h"
 #include "apps/raysift/guard_flags.h"
 #include "apps/raysift/render_flags.h"
+#include "apps/raysift/render_image.h"
 #include "apps/raysift/render_path.h"
 #include "apps/raysift/sampling_stats.h"
 #include "core/file_util.h"
@@ -80,9 +81,10 @@ void trace_one_pixel(const std::vector<int>& pixel, const volume::RayCaster& cas
 }
 
 /// `raysift render` under mpirun with N > 1 ranks: every rank runs this; rank 0 writes.
-void render_distributed(const RenderCliOptions& o, const PathCliOptions& p) {
+void render_distributed(const RenderCliOptions& o, const PathCliOptions& p, const CommonOptions& common) {
   if (!p.camera_path.empty() || !o.pixel.empty())
     throw UsageError("--camera-path and --pixel run in one process; start them without mpirun (or with -np 1)");
+  if (o.distribute == "image") return render_image_parallel(o, common);  // mpi19b: mpi/image_parallel.h
   throw UsageError("--distribute " + o.distribute + " under mpirun -np " + std::to_string(mpi::size()) +
                    ": not implemented yet (mpi skeleton)");
 }
@@ -98,7 +100,7 @@ RegisterCommand reg(
       return [opt, path, &common] {
         const Timer total;
         check_render_flags(*path, *opt);
-        if (mpi::size() > 1) return render_distributed(*opt, *path);
+        if (mpi::size() > 1) return render_distributed(*opt, *path, common);
         const RenderInputs in = build_inputs(*opt, common);
         if (!path->camera_path.empty()) return render_path(*path, *opt, in, common);
         const volume::RayCaster caster(in.volume, *in.tf, in.camera, in.options);

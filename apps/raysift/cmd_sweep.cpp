@@ -221,6 +221,7 @@ void run(const SweepOptions& o, const CommonOptions& common) {
     return run_units(mine, units, points, is_study, o, in, trade, first);
   });
   mpi::RankStats mine;
+  mine.active_voxels_loaded = in.info.active_voxels;  // every rank holds the whole volume
   mine.render_ms = timer.elapsed_ms();
   mine.bytes_sent = mpi::traffic().sent;
   mine.bytes_received = mpi::traffic().received;
