@@ -177,71 +177,93 @@ volume::RenderResult render_full_image_parallel(const volume::RayCaster& caster,
 namespace {
 
 #if RAYSIFT_HAVE_MPI
-/// The lock-step batch tracer: each rank traces its share of the group (group_share), one all-gather gives every
-/// rank all of it. Single-threaded by contract (render_sampled runs in a one-thread arena), so the buffers are
-/// reused and every rank makes its collectives in the same order.
+/// The lock-step tracer: each rank traces the positions ray_owner gives it and one all-gather gives every rank all
+/// of the set (a whole refinement round through trace_set, a budget group through trace_group). Called only from
+/// render_sampled in a one-thread arena, so every rank makes the same collectives in the same order and the
+/// buffers are reused; the rank's own rays are traced on all its threads.
 class LockstepTracer {
  public:
   LockstepTracer(const volume::RayCaster& caster, RankStats& stats) : caster_(caster), stats_(stats) {}
 
-  void operator()(Span<const std::uint32_t> pixels, Span<Rgba> out) {
-    const int me = rank(), n = size();
-    const Header header{std::uint32_t(pixels.size()), pixels.empty() ? 0u : pixels[0],
-                        pixels.empty() ? 0u : pixels[pixels.size() - 1]};
-    mine_.clear();
-    for (std::size_t k = std::size_t(me); k < pixels.size(); k += std::size_t(n)) mine_.push_back(pixels[k]);
-    rays_.resize(mine_.size());
-    const Timer trace;
-    caster_.trace_pixels(mine_, rays_);
-    stats_.render_ms += trace.elapsed_ms();
-    send_.resize(sizeof header + mine_.size() * sizeof(Rgba));
-    std::memcpy(send_.data(), &header, sizeof header);
-    for (std::size_t j = 0; j < rays_.size(); ++j) {
-      std::memcpy(send_.data() + sizeof header + j * sizeof(Rgba), &rays_[j].color, sizeof(Rgba));
-      samples += rays_[j].samples;
-    }
-    counts_.assign(std::size_t(n), 0);
-    displs_.assign(std::size_t(n), 0);
-    for (int r = 0; r < n; ++r) {
-      counts_[std::size_t(r)] = int(sizeof header + group_share(pixels.size(), r, n) * sizeof(Rgba));
-      if (r > 0) displs_[std::size_t(r)] = displs_[std::size_t(r - 1)] + counts_[std::size_t(r - 1)];
-    }
-    recv_.resize(std::size_t(displs_.back() + counts_.back()));
-    const Timer exchange;
-    MPI_Allgatherv(send_.data(), int(send_.size()), MPI_BYTE, recv_.data(), counts_.data(), displs_.data(), MPI_BYTE,
-                   MPI_COMM_WORLD);
-    stats_.composite_ms += exchange.elapsed_ms();
-    stats_.bytes_sent += send_.size() * std::size_t(n - 1);
-    stats_.bytes_received += recv_.size() - send_.size();
-    unpack(header, out);
+  void trace_group(Span<const std::uint32_t> pixels, Span<Rgba> out) {
+    exchange(pixels, [&](std::size_t k, const Rgba& c) { out[k] = c; });
+  }
+  void trace_set(Span<const std::uint32_t> pixels, ImageRGBA& image) {
+    exchange(pixels, [&](std::size_t k, const Rgba& c) { image.pixels[pixels[k]] = c; });
   }
 
   std::uint64_t samples = 0;  ///< volume samples this rank's rays took
 
  private:
   struct Header {
-    std::uint32_t count, first, last;  ///< the group every rank must be tracing
+    std::uint32_t count, first, last;  ///< the set every rank must be tracing
   };
 
-  void unpack(const Header& header, Span<Rgba> out) const {
+  void trace_mine(Span<const std::uint32_t> pixels) {
+    const int me = rank(), n = size();
+    mine_.clear();
+    for (std::size_t k = 0; k < pixels.size(); ++k)
+      if (ray_owner(k, pixels.size(), n) == me) mine_.push_back(pixels[k]);
+    rays_.resize(mine_.size());
+    const Timer timer;
+    std::atomic<std::uint64_t> taken{0};
+    all_threads_.execute([&] {
+      parallel_chunks(mine_.size(), sampling::kRayGroup, [&](std::size_t, std::size_t begin, std::size_t end) {
+        caster_.trace_pixels(Span<const std::uint32_t>(mine_.data() + begin, end - begin),
+                             Span<volume::RaySample>(rays_.data() + begin, end - begin));
+        std::uint64_t t = 0;
+        for (std::size_t i = begin; i < end; ++i) t += rays_[i].samples;
+        taken += t;
+      });
+    });
+    samples += taken;
+    stats_.render_ms += timer.elapsed_ms();
+  }
+
+  template <typename Store>
+  void exchange(Span<const std::uint32_t> pixels, const Store& store) {
     const int n = size();
+    const Header header{std::uint32_t(pixels.size()), pixels.empty() ? 0u : pixels[0],
+                        pixels.empty() ? 0u : pixels[pixels.size() - 1]};
+    trace_mine(pixels);
+    send_.resize(sizeof header + rays_.size() * sizeof(Rgba));
+    std::memcpy(send_.data(), &header, sizeof header);
+    for (std::size_t j = 0; j < rays_.size(); ++j)
+      std::memcpy(send_.data() + sizeof header + j * sizeof(Rgba), &rays_[j].color, sizeof(Rgba));
+    counts_.assign(std::size_t(n), int(sizeof header));
+    for (std::size_t k = 0; k < pixels.size(); ++k) counts_[std::size_t(ray_owner(k, pixels.size(), n))] += int(sizeof(Rgba));
+    displs_.assign(std::size_t(n), 0);
+    for (int r = 1; r < n; ++r) displs_[std::size_t(r)] = displs_[std::size_t(r - 1)] + counts_[std::size_t(r - 1)];
+    recv_.resize(std::size_t(displs_.back() + counts_.back()));
+    const Timer timer;
+    MPI_Allgatherv(send_.data(), int(send_.size()), MPI_BYTE, recv_.data(), counts_.data(), displs_.data(), MPI_BYTE,
+                   MPI_COMM_WORLD);
+    stats_.composite_ms += timer.elapsed_ms();
+    stats_.bytes_sent += send_.size() * std::size_t(n - 1);
+    stats_.bytes_received += recv_.size() - send_.size();
     for (int r = 0; r < n; ++r) {
-      const std::uint8_t* at = recv_.data() + displs_[std::size_t(r)];
       Header theirs;
-      std::memcpy(&theirs, at, sizeof theirs);
+      std::memcpy(&theirs, recv_.data() + displs_[std::size_t(r)], sizeof theirs);
       // A mismatch means the ranks' sampling runs diverged: a bug, never input.
       RAYSIFT_CHECK(theirs.count == header.count && theirs.first == header.first && theirs.last == header.last);
-      for (std::size_t k = std::size_t(r), j = 0; k < out.size(); k += std::size_t(n), ++j)
-        std::memcpy(&out[k], at + sizeof theirs + j * sizeof(Rgba), sizeof(Rgba));
+    }
+    cursor_.assign(std::size_t(n), 0);
+    for (std::size_t k = 0; k < pixels.size(); ++k) {
+      const std::size_t r = std::size_t(ray_owner(k, pixels.size(), n));
+      Rgba c;
+      std::memcpy(&c, recv_.data() + displs_[r] + sizeof(Header) + cursor_[r]++ * sizeof(Rgba), sizeof c);
+      store(k, c);
     }
   }
 
   const volume::RayCaster& caster_;
   RankStats& stats_;
+  tbb::task_arena all_threads_;  ///< the rank's own rays use every thread, unlike the lock-step control
   std::vector<std::uint32_t> mine_;
   std::vector<volume::RaySample> rays_;
   std::vector<std::uint8_t> send_, recv_;
   std::vector<int> counts_, displs_;
+  std::vector<std::size_t> cursor_;
 };
 
 template <typename T>
@@ -329,8 +351,9 @@ sampling::SampledRender render_sampled_image_parallel(const volume::Volume& volu
   sampling::SampledFrame frame;
   tbb::task_arena one_thread(1);
   one_thread.execute([&] {
-    frame = sampling::render_sampled(importance, [&tracer](Span<const std::uint32_t> p, Span<Rgba> o) { tracer(p, o); },
-                                     options, importance_ms);
+    const sampling::SetTracer set{[&tracer](Span<const std::uint32_t> p, ImageRGBA& image) { tracer.trace_set(p, image); },
+                                  [&tracer](Span<const std::uint32_t> p, Span<Rgba> o) { tracer.trace_group(p, o); }};
+    frame = sampling::render_sampled(importance, set, options, importance_ms);
   });
   out.samples = sum_on_root(tracer.samples);
   if (!is_root()) return out;

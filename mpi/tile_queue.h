@@ -39,10 +39,11 @@ class TileQueue {
   int tiles_, next_ = 0, pending_stops_;
 };
 
-/// Rays of a group of `count` that `rank` of `size` traces in the lock-step sampled mode: positions
-/// rank, rank + size, ... \pre 0 <= rank < size
-inline std::size_t group_share(std::size_t count, int rank, int size) {
-  return count > std::size_t(rank) ? (count - std::size_t(rank) + std::size_t(size) - 1) / std::size_t(size) : 0;
+/// \brief The rank that traces position k of a set of n rays in the lock-step sampled modes. Sets of at least
+/// `chunk` x size rays go in interleaved chunks (neighbouring rays share volume blocks, and the interleave
+/// balances costly regions), smaller ones (the budget's groups) ray by ray. \pre size >= 1, chunk >= 1
+inline int ray_owner(std::size_t k, std::size_t n, int size, std::size_t chunk = 32) {
+  return int((n >= chunk * std::size_t(size) ? k / chunk : k) % std::size_t(size));
 }
 
 }  // namespace raysift::mpi

@@ -26,6 +26,7 @@ void OvershootMargin::update(double frame_ms, double target_ms) {
 }
 
 void trace_all(Span<const std::uint32_t> pixels, const TraceBatch& trace, ImageRGBA& image) {
+  if (const auto* set = trace.target<SetTracer>()) return set->trace_set(pixels, image);
   const std::size_t groups = (pixels.size() + kRayGroup - 1) / kRayGroup;
   parallel_for_each(groups, [&](std::size_t g) {
     const std::size_t first = g * kRayGroup, count = std::min(kRayGroup, pixels.size() - first);

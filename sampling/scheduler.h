@@ -18,7 +18,17 @@ using TraceBatch = std::function<void(Span<const std::uint32_t> pixels, Span<Rgb
 /// Rays handed to a worker at a time (RP paper section 7.6).
 inline constexpr std::size_t kRayGroup = 32;
 
-/// Traces every pixel of `pixels` in parallel groups of kRayGroup and stores the results in `image`.
+/// \brief A batch tracer that also takes a whole set at once. Stored in a TraceBatch, trace_all hands it each set in
+/// one call instead of one call per group of kRayGroup: the lock-step MPI ranks of mpi/image_parallel.h then make
+/// one exchange per refinement round, not one per 32 rays. trace_until still launches groups through `batch`.
+struct SetTracer {
+  std::function<void(Span<const std::uint32_t> pixels, ImageRGBA& image)> trace_set;  ///< writes image.pixels[p]
+  TraceBatch batch;
+  void operator()(Span<const std::uint32_t> pixels, Span<Rgba> out) const { batch(pixels, out); }
+};
+
+/// Traces every pixel of `pixels` in parallel groups of kRayGroup and stores the results in `image` (a SetTracer
+/// gets the whole set).
 void trace_all(Span<const std::uint32_t> pixels, const TraceBatch& trace, ImageRGBA& image);
 
 /// Milliseconds since the frame began. The wall clock in production; tests inject a virtual clock that a

@@ -42,15 +42,17 @@ TEST(TileQueue, DealsEveryTileOnceThenFinishesAfterOneStopPerOutstandingRequest)
   EXPECT_TRUE(queue.finished());
 }
 
-TEST(GroupShare, SharesPartitionTheGroup) {
-  for (std::size_t count : {0u, 1u, 2u, 5u, 31u, 32u})
-    for (int n = 1; n <= 4; ++n) {
-      std::size_t sum = 0;
-      for (int r = 0; r < n; ++r) sum += group_share(count, r, n);
-      EXPECT_EQ(sum, count) << count << " over " << n;
-    }
-  EXPECT_EQ(group_share(5, 0, 3), 2u);  // positions 0, 3
-  EXPECT_EQ(group_share(5, 2, 3), 1u);  // position 2
+TEST(RayOwner, SmallSetsGoRayByRayLargeOnesInInterleavedChunks) {
+  EXPECT_EQ(ray_owner(0, 5, 3), 0);
+  EXPECT_EQ(ray_owner(4, 5, 3), 1);  // 5 < 32 x 3: position k on rank k % 3
+  const std::size_t n = 32 * 3 * 2 + 7;
+  std::vector<std::size_t> per_rank(3, 0);
+  for (std::size_t k = 0; k < n; ++k) {
+    EXPECT_EQ(ray_owner(k, n, 3), int((k / 32) % 3)) << k;
+    ++per_rank[std::size_t(ray_owner(k, n, 3))];
+  }
+  EXPECT_EQ(per_rank, (std::vector<std::size_t>{64 + 7, 64, 64}));
+  EXPECT_EQ(ray_owner(100, 200, 1), 0);
 }
 
 TEST(DealtUnits, RoundRobinCoversEveryUnitOnce) {
