@@ -2,6 +2,7 @@
 
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstring>
 
@@ -192,6 +193,21 @@ class LockstepTracer {
     exchange(pixels, [&](std::size_t k, const Rgba& c) { image.pixels[pixels[k]] = c; });
   }
 
+  /// Budget mode: the queue in chunks of kChunkGroups groups per rank while rank 0's clock (`elapsed_ms`, a
+  /// broadcast) is before the deadline: a prefix, two collectives per chunk instead of per group.
+  std::size_t trace_prefix(Span<const std::uint32_t> queue, ImageRGBA& image, const std::function<double()>& elapsed_ms,
+                           double deadline_ms) {
+    const std::size_t chunk = kChunkGroups * sampling::kRayGroup * std::size_t(size());
+    std::size_t done = 0;
+    while (done < queue.size() && elapsed_ms() < deadline_ms) {
+      const std::size_t n = std::min(chunk, queue.size() - done);
+      trace_set(Span<const std::uint32_t>(queue.data() + done, n), image);
+      done += n;
+    }
+    return done;
+  }
+
+  static constexpr std::size_t kChunkGroups = 8;
   std::uint64_t samples = 0;  ///< volume samples this rank's rays took
 
  private:
@@ -352,7 +368,11 @@ sampling::SampledRender render_sampled_image_parallel(const volume::Volume& volu
   tbb::task_arena one_thread(1);
   one_thread.execute([&] {
     const sampling::SetTracer set{[&tracer](Span<const std::uint32_t> p, ImageRGBA& image) { tracer.trace_set(p, image); },
-                                  [&tracer](Span<const std::uint32_t> p, Span<Rgba> o) { tracer.trace_group(p, o); }};
+                                  [&tracer](Span<const std::uint32_t> p, Span<Rgba> o) { tracer.trace_group(p, o); },
+                                  [&tracer](Span<const std::uint32_t> q, ImageRGBA& image,
+                                            const std::function<double()>& elapsed_ms, double deadline_ms) {
+                                    return tracer.trace_prefix(q, image, elapsed_ms, deadline_ms);
+                                  }};
     frame = sampling::render_sampled(importance, set, options, importance_ms);
   });
   out.samples = sum_on_root(tracer.samples);
