@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <tuple>
 #include <fstream>
 #include <sstream>
@@ -26,18 +27,86 @@ std::uint64_t process_bytes_read() {
   return 0;
 }
 
+/// OpenVDB's message, one line and short: on a truncated file it can quote kilobytes of garbage as a name.
+std::string short_reason(const std::string& what) {
+  std::string out;
+  for (char c : what) {
+    const bool printable = c >= 0x21 && c <= 0x7e;
+    if (printable) out += c;
+    else if (!out.empty() && out.back() != ' ') out += ' ';
+    if (out.size() >= 120) return out + "...";
+  }
+  return out;
+}
+
+/// Bounds-checked reads of the archive's framing (the format of openvdb/io/Archive.cc and GridDescriptor.cc).
+struct FrameReader {
+  std::ifstream in;
+  std::uint64_t size;
+  template <typename T>
+  T value() {
+    T v{};
+    in.read(reinterpret_cast<char*>(&v), sizeof v);
+    if (!in) throw IoError("ends inside its header");
+    return v;
+  }
+  void skip(std::uint64_t bytes) {
+    const auto at = std::uint64_t(in.tellg());
+    if (bytes > size - at) throw IoError("ends inside its header");
+    in.seekg(std::streamoff(bytes), std::ios::cur);
+  }
+  void skip_string() { skip(value<std::uint32_t>()); }
+};
+
+/// Throws IoError unless the header, metadata and grid descriptors parse within the file and every grid ends
+/// inside it. io::File reads with unchecked streams: on a truncated file it would read garbage sizes and
+/// allocate gigabytes (delayed loading) instead of failing.
+void check_archive_intact(const std::string& path) {
+  FrameReader r{std::ifstream(path, std::ios::binary), std::uint64_t(std::filesystem::file_size(path))};
+  auto fail = [&](const std::string& why) {
+    return IoError(file_message(path, "not a valid OpenVDB file or truncated/corrupt (" + why +
+                                          "); re-export it or check the download"));
+  };
+  try {
+    if (r.value<std::int64_t>() != 0x56444220) throw IoError("no VDB magic number");
+    const auto version = r.value<std::uint32_t>();
+    if (version >= 211) r.skip(8);  // library major and minor version
+    const bool offsets = version >= 212 && r.value<char>() != 0;
+    if (version >= 220) r.skip(36);  // UUID
+    for (auto meta = r.value<std::uint32_t>(); meta > 0; --meta) {  // file metadata: name, type, sized value
+      r.skip_string();
+      r.skip_string();
+      r.skip(r.value<std::uint32_t>());
+    }
+    if (!offsets) return;  // pre-2.0 files: nothing to check cheaply
+    for (auto grids = r.value<std::int32_t>(); grids > 0; --grids) {
+      r.skip_string();                     // unique name
+      r.skip_string();                     // grid type
+      if (version >= 216) r.skip_string();  // instance parent
+      const auto grid_pos = r.value<std::int64_t>(), block_pos = r.value<std::int64_t>();
+      const auto end_pos = r.value<std::int64_t>();
+      if (!(grid_pos <= block_pos && block_pos <= end_pos && std::uint64_t(end_pos) <= r.size))
+        throw IoError("a grid ends at byte " + std::to_string(end_pos) + " of " + std::to_string(r.size));
+      r.in.seekg(end_pos);
+    }
+  } catch (const IoError& e) {
+    throw fail(e.what());
+  }
+}
+
 /// Runs `read` with OpenVDB's and the C++ library's failures turned into one IoError naming the file.
 template <typename F>
 auto guarded_read(const std::string& path, F&& read) {
   require_readable_file(path);  // IoError for missing / directory / unreadable, as load_vdb
+  check_archive_intact(path);
   detail::ensure_openvdb_initialized();
   try {
     return read();
   } catch (const openvdb::Exception& e) {
-    throw IoError(file_message(path, std::string("not a valid OpenVDB file or truncated/corrupt (") + e.what() +
+    throw IoError(file_message(path, "not a valid OpenVDB file or truncated/corrupt (" + short_reason(e.what()) +
                                          "); re-export it or check the download"));
   } catch (const std::ios_base::failure& e) {
-    throw IoError(file_message(path, std::string("truncated or unreadable (") + e.what() + ")"));
+    throw IoError(file_message(path, "truncated or unreadable (" + short_reason(e.what()) + ")"));
   } catch (const std::bad_alloc&) {
     throw IoError(file_message(path, "not a valid OpenVDB file (a size field is implausibly large)"));
   }
