@@ -279,6 +279,13 @@ RaySample RayCaster::Impl::trace(int x, int y) const {
     k = std::max(0L, ceil_long((tv_in - t_in) * inv_dt - xi) - 1);
     t_end = std::min(t_out, tv_out + dt);
   }
+  const SegmentClip& clip = options.clip;
+  if (clip.enabled) {  // start one step before the brick; the per-sample test below decides ownership exactly
+    double tc_in, tc_out;
+    if (!clip_to_box(o, inv_d, clip.lo, clip.hi, tc_in, tc_out) || tc_out < t_in) return out;
+    k = std::max(k, ceil_long((std::max(tc_in, t_in) - t_in) * inv_dt - xi) - 1);
+    t_end = std::min(t_end, tc_out + dt);
+  }
 
   const VolumeBricks& vb = *bricks;
   const bool shaded = options.shading == Shading::Phong;
@@ -290,6 +297,11 @@ RaySample RayCaster::Impl::trace(int x, int y) const {
     const double t = t_in + (double(k) + xi) * dt;
     if (!(t < t_end)) break;
     const Vec3d p = o + dir * t;
+    if (clip.enabled && !(p.x >= clip.lo.x && p.y >= clip.lo.y && p.z >= clip.lo.z && p.x < clip.hi.x &&
+                          p.y < clip.hi.y && p.z < clip.hi.z)) {
+      ++k;  // another brick's sample
+      continue;
+    }
     const Cell cell(p.x, p.y, p.z);
     const std::int64_t block = vb.block_of(cell);
     if (skip && (block < 0 || !block_visible[std::size_t(block)])) {
@@ -586,8 +598,10 @@ RayCaster::RayCaster(const Volume& volume, std::shared_ptr<const VolumeBricks> b
   const VolumeBricks& vb = *m.bricks;
   m.is_empty = vb.is_empty;
   if (m.is_empty) return;
-  m.domain_lo = Vec3d(vb.index_min) - Vec3d{1, 1, 1};
-  m.domain_hi = Vec3d(vb.index_max) + Vec3d{1, 1, 1};
+  // A clipped brick enters the rays where the whole volume does, so that its samples lie on the same lattice.
+  const SegmentClip& clip = options.clip;
+  m.domain_lo = Vec3d(clip.enabled ? clip.lattice_min : vb.index_min) - Vec3d{1, 1, 1};
+  m.domain_hi = Vec3d(clip.enabled ? clip.lattice_max : vb.index_max) + Vec3d{1, 1, 1};
   m.block_visible.resize(vb.lo.size());
   Vec3i vis_lo{INT32_MAX, INT32_MAX, INT32_MAX}, vis_hi{INT32_MIN, INT32_MIN, INT32_MIN};
   for (int k = 0; k < vb.dims.z; ++k)

@@ -42,6 +42,20 @@ struct PhongParams {
   double min_gradient = 1e-3;
 };
 
+/// Sort-last rendering (mpi/data_parallel.h): a rank that holds one brick of the volume renders only the ray
+/// segment inside it. Samples stay on the whole volume's lattice t_k = t_entry + (k + ξ)·Δt, with t_entry
+/// taken from `lattice_min/max` (the whole grid's active voxel bbox, inclusive) instead of this rank's grid,
+/// and a sample is kept iff its index-space position p satisfies lo <= p < hi on every axis. Bricks that
+/// tile space with shared planes thus own every sample position exactly once.
+struct SegmentClip {
+  bool enabled = false;
+  Vec3d lo{-std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+           -std::numeric_limits<double>::infinity()};
+  Vec3d hi{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+           std::numeric_limits<double>::infinity()};
+  Vec3i lattice_min, lattice_max;
+};
+
 struct RenderOptions {
   double step_voxels = 0.5;           ///< sample distance in voxels (index-space length), in (0, 64]
   Shading shading = Shading::None;
@@ -52,6 +66,7 @@ struct RenderOptions {
   bool jitter = false;                ///< random start offset ξ per pixel instead of 0.5
   std::uint64_t seed = 1;             ///< jitter seed: ξ = hash(pixel, seed)
   int lut_size = 4096;                ///< transfer-function table entries, >= 2
+  SegmentClip clip;                   ///< disabled: the whole ray
 };
 
 /// One traced ray.

@@ -2,6 +2,7 @@
 // caster) -> run the selected mode -> write. A new mode adds one entry to `modes()` (and its flags in
 // render_flags.cpp); everything before and after the dispatch is shared, so all modes composite and write alike.
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -9,7 +10,6 @@
 #include "apps/raysift/command.h"
 #include "apps/raysift/guard_flags.h"
 #include "apps/raysift/render_flags.h"
-#include "apps/raysift/render_image.h"
 #include "apps/raysift/render_path.h"
 #include "apps/raysift/sampling_stats.h"
 #include "core/file_util.h"
@@ -17,7 +17,11 @@
 #include "core/progress.h"
 #include "core/signals.h"
 #include "core/timer.h"
+#include "core/memory_limit.h"
+#include "mpi/data_parallel.h"
+#include "mpi/image_parallel.h"
 #include "mpi/session.h"
+#include "volume/volume.h"
 
 namespace raysift::app {
 namespace {
@@ -80,13 +84,109 @@ void trace_one_pixel(const std::vector<int>& pixel, const volume::RayCaster& cas
               x, y, r.color.r, r.color.g, r.color.b, r.color.a, c.r, c.g, c.b, r.depth, r.samples);
 }
 
-/// `raysift render` under mpirun with N > 1 ranks: every rank runs this; rank 0 writes.
-void render_distributed(const RenderCliOptions& o, const PathCliOptions& p, const CommonOptions& common) {
+/// The stats keys every single-frame render writes.
+Json frame_stats(const RenderCliOptions& o, const RenderInputs& in, std::uint64_t rays, std::uint64_t samples,
+                 std::uint64_t visible_blocks, double setup_ms, double trace_ms, double total_ms) {
+  return {{"mode", o.mode},
+          {"width", in.camera.width},
+          {"height", in.camera.height},
+          {"rays_traced", rays},
+          {"samples", samples},
+          {"step_voxels", in.options.step_voxels},
+          {"skip_empty_space", in.options.skip_empty_space},
+          {"visible_blocks", visible_blocks},
+          {"times_ms", {{"setup", setup_ms}, {"trace", trace_ms}, {"frame", trace_ms}, {"total", total_ms}}}};
+}
+
+void write_frame(const std::string& out, ImageRGBA& image) {
+  if (file_extension(out) == ".png")  // colour is already composited: show it opaque
+    for (Rgba& p : image.pixels) p.a = 1.0f;
+  write_image(out, image);
+}
+
+/// --distribute image (mpi19b, mpi/image_parallel.h): every rank holds the whole grid and traces part of the frame.
+void render_image(const RenderCliOptions& o, const RenderInputs& in, const CommonOptions& common,
+                  mpi::RankStats stats, const Timer& total) {
+  const volume::RayCaster caster(in.volume, *in.tf, in.camera, in.options);
+  const double setup_ms = total.elapsed_ms();
+  const Timer trace;
+  ModeOutput out;
+  if (o.mode == "full") {
+    volume::RenderResult r = mpi::render_full_image_parallel(caster, stats);
+    out = ModeOutput{std::move(r.image), r.rays_traced, r.samples, Json::object()};
+  } else {
+    sampling::SampledRender r = mpi::render_sampled_image_parallel(in.volume, *in.tf, caster, in.sampled, stats);
+    Json extra = mpi::is_root() ? sampled_render_json(r, in.sampled.sampling.budget_ms) : Json::object();
+    out = ModeOutput{std::move(r.image), r.rays_traced, r.samples, std::move(extra)};
+  }
+  const double trace_ms = trace.elapsed_ms();
+  stats.bytes_sent += mpi::traffic().sent;
+  stats.bytes_received += mpi::traffic().received;
+  const Json ranks = mpi::gather_rank_stats(stats, "image");
+  if (!mpi::is_root()) return;
+  write_frame(o.out, out.image);
+  Json json = frame_stats(o, in, out.rays_traced, out.samples, caster.visible_block_count(), setup_ms, trace_ms,
+                          total.elapsed_ms());
+  json.merge_patch(out.extra_stats);
+  json.merge_patch(ranks);
+  write_stats_if_requested(common, json);
+}
+
+/// --distribute auto: data when the whole grid does not fit one rank's --max-memory, else image.
+std::string choose_distribution(const std::string& flag, std::uint64_t active_voxels, const MemoryLimit& limit) {
+  if (flag != "auto") return flag;
+  const std::uint64_t per_rank = limit.bytes ? limit.bytes : available_memory_bytes();
+  return volume::grid_bytes_upper_bound(active_voxels) > per_rank ? "data" : "image";
+}
+
+/// `raysift render` under mpirun with N > 1 ranks: every rank runs this, rank 0 alone writes. The reader plans
+/// the bricks (rank 0 reads the topology), resolves --distribute auto, then reads this rank's brick (data) or
+/// the whole grid (image).
+void render_distributed(const RenderCliOptions& o, const PathCliOptions& p, const CommonOptions& common_flags,
+                        const Timer& total) {
   if (!p.camera_path.empty() || !o.pixel.empty())
     throw UsageError("--camera-path and --pixel run in one process; start them without mpirun (or with -np 1)");
-  if (o.distribute == "image") return render_image_parallel(o, common);  // mpi19b: mpi/image_parallel.h
-  throw UsageError("--distribute " + o.distribute + " under mpirun -np " + std::to_string(mpi::size()) +
-                   ": not implemented yet (mpi skeleton)");
+  CommonOptions common = common_flags;
+  common.quiet = common.quiet || !mpi::is_root();  // one copy of each warning
+  const MemoryLimit limit = memory_limit(common);
+  std::string distribute = o.distribute;
+  mpi::DataParallelPlan plan;
+  mpi::RankStats stats;
+  const VolumeReader reader = [&](const std::string& path, const std::string& grid, const volume::LoadVdbOptions& load) {
+    plan = mpi::plan_bricks(path, grid);
+    distribute = choose_distribution(distribute, plan.active_voxels, limit);
+    if (distribute == "data" && o.mode != "full")
+      throw UsageError("--distribute data renders --mode full only; use --distribute image for --mode " + o.mode);
+    if (distribute == "image") {  // every rank holds the whole grid
+      VolumeRead whole;
+      mpi::all_or_none([&] { whole.volume = volume::load_vdb(path, plan.grid, load, &whole.non_finite_voxels); });
+      whole.info = whole.volume.info();
+      stats.active_voxels_loaded = whole.info.active_voxels;  // mpi19b: the whole grid
+      std::error_code no_size;
+      stats.bytes_read = std::filesystem::file_size(path, no_size);
+      return whole;
+    }
+    mpi::BrickInput brick = mpi::load_brick(plan, path, load, limit);
+    stats = brick.stats;
+    return VolumeRead{std::move(brick.volume), brick.info, brick.non_finite_voxels};
+  };
+  const RenderInputs in = build_inputs(o, common, reader);
+  if (distribute == "image") return render_image(o, in, common, stats, total);  // mpi19b: mpi/image_parallel.h
+  const double setup_ms = total.elapsed_ms();
+  const Timer trace;
+  mpi::DataParallelFrame frame = mpi::render_data_parallel(plan, in.volume, *in.tf, in.camera, in.options);
+  const double trace_ms = trace.elapsed_ms();
+  stats.render_ms = frame.render_ms;
+  stats.composite_ms = frame.composite_ms;
+  stats.bytes_sent = mpi::traffic().sent;
+  stats.bytes_received = mpi::traffic().received;
+  const Json ranks = mpi::gather_rank_stats(stats, distribute);
+  if (!mpi::is_root()) return;
+  write_frame(o.out, frame.image);
+  Json out = frame_stats(o, in, std::uint64_t(in.camera.width) * std::uint64_t(in.camera.height), frame.samples,
+                         frame.visible_blocks, setup_ms, trace_ms, total.elapsed_ms());
+  out.merge_patch(ranks);
+  write_stats_if_requested(common, out);
 }
 
 RegisterCommand reg(
@@ -100,7 +200,7 @@ RegisterCommand reg(
       return [opt, path, &common] {
         const Timer total;
         check_render_flags(*path, *opt);
-        if (mpi::size() > 1) return render_distributed(*opt, *path, common);
+        if (mpi::size() > 1) return render_distributed(*opt, *path, common, total);
         const RenderInputs in = build_inputs(*opt, common);
         if (!path->camera_path.empty()) return render_path(*path, *opt, in, common);
         const volume::RayCaster caster(in.volume, *in.tf, in.camera, in.options);
@@ -113,22 +213,13 @@ RegisterCommand reg(
         const Timer trace;
         ModeOutput result = modes().at(opt->mode)(in, caster, common);
         const double trace_ms = trace.elapsed_ms();
-        if (file_extension(opt->out) == ".png")  // colour is already composited: show it opaque
-          for (Rgba& p : result.image.pixels) p.a = 1.0f;
-        write_image(opt->out, result.image);
+        write_frame(opt->out, result.image);
         const double total_ms = total.elapsed_ms();
         if (common.verbose)
           std::cerr << "setup " << setup_ms << " ms, trace " << trace_ms << " ms, total " << total_ms << " ms, "
                     << result.samples << " samples\n";
-        Json stats = {{"mode", opt->mode},
-                      {"width", in.camera.width},
-                      {"height", in.camera.height},
-                      {"rays_traced", result.rays_traced},
-                      {"samples", result.samples},
-                      {"step_voxels", in.options.step_voxels},
-                      {"skip_empty_space", in.options.skip_empty_space},
-                      {"visible_blocks", caster.visible_block_count()},
-                      {"times_ms", {{"setup", setup_ms}, {"trace", trace_ms}, {"frame", trace_ms}, {"total", total_ms}}}};
+        Json stats = frame_stats(*opt, in, result.rays_traced, result.samples, caster.visible_block_count(), setup_ms,
+                                 trace_ms, total_ms);
         stats.merge_patch(result.extra_stats);  // keeps times_ms.setup next to the sampled modes' stage times
         write_stats_if_requested(common, stats);
       };

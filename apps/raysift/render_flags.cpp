@@ -7,6 +7,7 @@
 #include "apps/raysift/cli_checks.h"
 #include "apps/raysift/guard_flags.h"
 #include "apps/raysift/sampling_flags.h"
+#include "core/camera_fit.h"
 #include "core/file_util.h"
 #include "core/memory_limit.h"
 #include "core/scene.h"
@@ -130,6 +131,17 @@ void check_render_flags(PathCliOptions& p, RenderCliOptions& o) {
   check_mode_flags(o);
 }
 
+/// volume::fit_camera's view from a GridInfo, which under --distribute data describes the whole grid while the
+/// volume is one brick.
+CameraSpec fit_camera_to_info(const volume::GridInfo& info, int width, int height) {
+  Bbox3d box;
+  if (info.active_voxels > 0) {
+    box.expand(info.bbox_min);
+    box.expand(info.bbox_max);
+  }
+  return fit_camera_to_box(box, width, height);
+}
+
 /// The image buffers of one render. The sampled modes keep an importance map, the traced samples, their masks
 /// and a composited copy beside the frame; progressive rendering adds its sample accumulator. Counted as
 /// multiples of the full render's colour+depth buffers (20 bytes per pixel).
@@ -139,8 +151,9 @@ std::uint64_t render_bytes(const RenderCliOptions& o, const CameraSpec& camera) 
   return frame * (o.progressive > 0 ? 5 : 4);
 }
 
-RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common) {
-  VolumeInput input = load_volume_input(o.input, common.scene_path, common, "render", volume::EmptyGrid::Allow);
+RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common, const VolumeReader& reader) {
+  VolumeInput input =
+      load_volume_input(o.input, common.scene_path, common, "render", volume::EmptyGrid::Allow, reader);
   if (!input.tf) throw UsageError("render needs --tf TF.json or a --scene with a 'transfer_function'; see --help");
   const Scene& scene = input.scene;
   const volume::GridInfo& info = input.info;
@@ -169,7 +182,7 @@ RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common
       throw InvalidInput(file_message(camera_source, e.what()));
     }
   } else {
-    in.camera = volume::fit_camera(in.volume, width, height);
+    in.camera = fit_camera_to_info(info, width, height);
   }
   require_memory(render_bytes(o, in.camera), memory_limit(common), SizeSource::Flag,
                  "a " + std::to_string(in.camera.width) + "x" + std::to_string(in.camera.height) + " " + o.mode +

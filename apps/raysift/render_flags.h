@@ -69,8 +69,9 @@ void add_render_options(CLI::App& sub, RenderCliOptions& o, PathCliOptions& p, c
 /// The rules that depend on other flags' values; takes "saliency" out of --features. \throw UsageError.
 void check_render_flags(PathCliOptions& p, RenderCliOptions& o);
 
-/// \throw UsageError without a TF; IoError/InvalidInput for unreadable inputs.
-RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common);
+/// \throw UsageError without a TF; IoError/InvalidInput for unreadable inputs. `reader` replaces the whole-file
+/// read (a data-parallel rank's brick); the default camera and the TF range then follow its whole-grid GridInfo.
+RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common, const VolumeReader& reader = {});
 
 /// The effective options as a command line that reproduces the render (verbose mode).
 std::string echo_command(const RenderCliOptions& o, const RenderInputs& in, const CommonOptions& common);

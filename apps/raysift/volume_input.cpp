@@ -29,7 +29,7 @@ volume::TfJsonOptions tf_json_options(const VolumeFlags& flags, const volume::Gr
 }
 
 VolumeInput load_volume_input(const VolumeFlags& flags, const std::string& scene_path, const CommonOptions& common,
-                              const std::string& command, volume::EmptyGrid empty) {
+                              const std::string& command, volume::EmptyGrid empty, const VolumeReader& reader) {
   VolumeInput in;
   if (!scene_path.empty()) in.scene = load_scene(scene_path);
   in.volume_path = !flags.volume.empty() ? flags.volume : in.scene.volume;
@@ -39,11 +39,18 @@ VolumeInput load_volume_input(const VolumeFlags& flags, const std::string& scene
   load.empty = empty;
   load.non_finite = non_finite_policy(common);
   const std::string& grid = !flags.grid.empty() ? flags.grid : in.scene.grid;
-  in.volume = volume::load_vdb(in.volume_path, grid, load, &in.non_finite_voxels);
+  if (reader) {
+    VolumeRead read = reader(in.volume_path, grid, load);
+    in.volume = std::move(read.volume);
+    in.info = read.info;
+    in.non_finite_voxels = read.non_finite_voxels;
+  } else {
+    in.volume = volume::load_vdb(in.volume_path, grid, load, &in.non_finite_voxels);
+    in.info = in.volume.info();
+  }
   if (in.non_finite_voxels > 0 && !common.quiet)
     std::cerr << "raysift: warning: " << in.volume_path << ": " << in.non_finite_voxels << " NaN/Inf voxels loaded with --non-finite "
               << common.non_finite << "\n";
-  in.info = in.volume.info();
 
   const volume::TfJsonOptions tf_options = tf_json_options(flags, in.info);
   if (!flags.tf.empty()) {

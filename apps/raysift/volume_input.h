@@ -2,6 +2,7 @@
 /// \file The volume + transfer-function input that `render`, `mesh`, `sweep` and `demo` share: the positional
 /// VOLUME, --grid, --tf and --tf-normalized, each falling back to the --scene's fields.
 #include <CLI/CLI.hpp>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -33,6 +34,16 @@ struct VolumeInput {
   std::uint64_t non_finite_voxels = 0;          ///< NaN/Inf voxels that --non-finite replaced
 };
 
+/// Reads the grid in place of volume::load_vdb (a data-parallel rank reads only its brick, mpi/data_parallel.h).
+/// Returns the volume and the GridInfo of the WHOLE grid, whose value range normalises the TF.
+struct VolumeRead {
+  volume::Volume volume;
+  volume::GridInfo info;
+  std::uint64_t non_finite_voxels = 0;
+};
+using VolumeReader = std::function<VolumeRead(const std::string& path, const std::string& grid,
+                                              const volume::LoadVdbOptions& options)>;
+
 /// How a TF file maps onto this grid: --tf-normalized over the data range (a constant grid: with its background).
 volume::TfJsonOptions tf_json_options(const VolumeFlags& flags, const volume::GridInfo& info);
 
@@ -42,6 +53,7 @@ volume::TfJsonOptions tf_json_options(const VolumeFlags& flags, const volume::Gr
 /// shows the background).
 /// \throw UsageError naming `command` when no volume is given; IoError/InvalidInput for unreadable files.
 VolumeInput load_volume_input(const VolumeFlags& flags, const std::string& scene_path, const CommonOptions& common,
-                              const std::string& command, volume::EmptyGrid empty = volume::EmptyGrid::Reject);
+                              const std::string& command, volume::EmptyGrid empty = volume::EmptyGrid::Reject,
+                              const VolumeReader& reader = {});
 
 }  // namespace raysift::app

@@ -20,8 +20,8 @@ using Row = std::map<std::string, std::string>;
 
 CliRun raysift(const std::string& dir, const std::string& args, int ranks = 1) {
   if (ranks == 1) return test::run_cli(RAYSIFT_EXE, dir, args);
-  // run_cli quotes its executable as one word; env takes the launcher's words as arguments.
-  return test::run_cli("/usr/bin/env", dir, RAYSIFT_MPIRUN " -np " + std::to_string(ranks) + " " RAYSIFT_EXE " " + args);
+  return test::run_cli(RAYSIFT_MPIEXEC, dir,
+                       "--oversubscribe --allow-run-as-root -np " + std::to_string(ranks) + " '" RAYSIFT_EXE "' " + args);
 }
 
 /// ball.vdb (radius 9 in 24^3), scene.json (48x32 camera), a second TF and a two-camera list.

@@ -1,0 +1,117 @@
+#include "mpi/data_parallel.h"
+
+#include <limits>
+
+#include "core/timer.h"
+#include "mpi/composite.h"
+#include "mpi/session.h"
+
+namespace raysift::mpi {
+
+DataParallelPlan plan_bricks(const std::string& path, const std::string& grid) {
+  Json plan_json;
+  all_or_none([&] {
+    if (!is_root()) return;
+    const volume::VdbLayout layout = volume::read_vdb_layout(path, grid);
+    plan_json = {{"grid", layout.grid},
+                 {"active_voxels", layout.active_voxels},
+                 {"index_min", {layout.index_min.x, layout.index_min.y, layout.index_min.z}},
+                 {"index_max", {layout.index_max.x, layout.index_max.y, layout.index_max.z}},
+                 {"split", kd_split_to_json(kd_split(layout, size()))}};
+  });
+  plan_json = broadcast_json(plan_json);
+  DataParallelPlan plan;
+  plan.grid = plan_json["grid"];
+  plan.active_voxels = plan_json["active_voxels"];
+  for (int a = 0; a < 3; ++a) plan.index_min[a] = plan_json["index_min"][a], plan.index_max[a] = plan_json["index_max"][a];
+  plan.split = kd_split_from_json(plan_json["split"]);
+  return plan;
+}
+
+namespace {
+
+/// The whole grid's GridInfo from the plan and every rank's brick (the union of the bricks holds every active
+/// voxel, so the agreed value range is the whole grid's).
+volume::GridInfo whole_grid_info(const DataParallelPlan& plan, const volume::Volume& brick) {
+  volume::GridInfo info = brick.info();
+  const bool has = info.active_voxels > 0;
+  constexpr double kBig = std::numeric_limits<double>::max();
+  info.value_min = min_all(has ? info.value_min : kBig);
+  info.value_max = max_all(has ? info.value_max : -kBig);
+  info.active_voxels = plan.active_voxels;
+  info.index_min = plan.index_min;
+  info.index_max = plan.index_max;
+  if (plan.active_voxels == 0) {
+    info.value_min = info.value_max = 0;
+    return info;
+  }
+  Bbox3d world;  // the eight transformed corners, as Volume::info() does for the whole grid
+  for (int c = 0; c < 8; ++c)
+    world.expand(brick.index_to_world({double((c & 1) ? plan.index_max.x : plan.index_min.x),
+                                       double((c & 2) ? plan.index_max.y : plan.index_min.y),
+                                       double((c & 4) ? plan.index_max.z : plan.index_min.z)}));
+  info.bbox_min = world.min;
+  info.bbox_max = world.max;
+  return info;
+}
+
+}  // namespace
+
+BrickInput load_brick(const DataParallelPlan& plan, const std::string& path, const volume::LoadVdbOptions& options,
+                      const MemoryLimit& limit) {
+  BrickInput in;
+  const Brick& mine = plan.split.bricks[std::size_t(rank())];
+  all_or_none([&] {
+    require_memory(volume::grid_bytes_upper_bound(mine.read_voxels_bound), limit, SizeSource::Input,
+                   "rank " + std::to_string(rank()) + "'s brick of " + path + " (" +
+                       std::to_string(mine.read_voxels_bound) + " active voxels with ghosts)",
+                   "start more ranks or raise --max-memory");
+    volume::BrickLoad load = volume::load_vdb_brick(path, plan.grid, mine.read_lo, mine.read_hi, options);
+    in.volume = std::move(load.volume);
+    in.stats.bytes_read = load.bytes_read;
+    in.non_finite_voxels = load.non_finite;
+  });
+  in.stats.active_voxels_loaded = in.volume.active_voxel_count();
+  in.non_finite_voxels = std::uint64_t(sum_all(double(in.non_finite_voxels)));
+  in.info = whole_grid_info(plan, in.volume);
+  return in;
+}
+
+DataParallelFrame render_data_parallel(const DataParallelPlan& plan, const volume::Volume& brick,
+                                       const volume::TransferFunction& tf, const CameraSpec& camera,
+                                       volume::RenderOptions options) {
+  const Brick& mine = plan.split.bricks[std::size_t(rank())];
+  const Vec3f background = options.background;
+  options.background = {0, 0, 0};  // segments stay premultiplied until the whole ray is composited
+  options.clip = {true, mine.own_lo, mine.own_hi, plan.index_min, plan.index_max};
+  DataParallelFrame frame;
+  std::vector<float> rgba;
+  all_or_none([&] {  // an invalid option or camera fails on every rank before any rank starts compositing
+    const Timer render;
+    const volume::RayCaster caster(brick, tf, camera, options);
+    const volume::RenderResult r = volume::render_full(caster);
+    frame.samples = r.samples;
+    frame.visible_blocks = caster.visible_block_count();
+    rgba.resize(r.image.pixels.size() * 4);
+    for (std::size_t i = 0; i < r.image.pixels.size(); ++i) {
+      const Rgba& p = r.image.pixels[i];
+      rgba[4 * i] = p.r, rgba[4 * i + 1] = p.g, rgba[4 * i + 2] = p.b, rgba[4 * i + 3] = p.a;
+    }
+    frame.render_ms = render.elapsed_ms();
+  });
+  const Timer composite;
+  const std::vector<int> order = visibility_order(plan.split, brick.world_to_index(camera.eye));
+  const std::vector<float> image = composite_sort_last(std::move(rgba), order);
+  frame.samples = std::uint64_t(sum_all(double(frame.samples)));
+  frame.visible_blocks = std::uint64_t(sum_all(double(frame.visible_blocks)));
+  if (is_root()) {
+    frame.image = ImageRGBA(camera.width, camera.height);
+    for (std::size_t i = 0; i < frame.image.pixels.size(); ++i)
+      frame.image.pixels[i] = volume::composite_over_background(
+          {image[4 * i], image[4 * i + 1], image[4 * i + 2], image[4 * i + 3]}, background);
+  }
+  frame.composite_ms = composite.elapsed_ms();
+  return frame;
+}
+
+}  // namespace raysift::mpi

@@ -1,0 +1,58 @@
+#pragma once
+/// \file Data-parallel (sort-last) volume rendering under MPI (docs/distributed.md):
+///   plan  = plan_bricks(path, grid);             // rank 0 reads the topology, k-d splits it, broadcasts
+///   brick = load_brick(plan, path, load);        // each rank reads its brick + ghosts; whole-grid GridInfo
+///   frame = render_data_parallel(plan, brick.volume, tf, camera, options);  // segments, binary swap, rank 0
+/// All three are collective (every rank calls them in this order). A failure on some ranks (an unreadable brick)
+/// is agreed with all_or_none(), so every rank throws the same RankFailure and none waits forever.
+#include <cstdint>
+#include <string>
+
+#include "core/camera.h"
+#include "core/image.h"
+#include "core/memory_limit.h"
+#include "mpi/kd_split.h"
+#include "mpi/rank_stats.h"
+#include "volume/raycaster.h"
+#include "volume/transfer_function.h"
+#include "volume/vdb_brick_io.h"
+
+namespace raysift::mpi {
+
+struct DataParallelPlan {
+  std::string grid;                 ///< the grid chosen (the default rule resolved once, on rank 0)
+  std::uint64_t active_voxels = 0;  ///< of the whole grid
+  Vec3i index_min, index_max;       ///< whole grid's inclusive active bbox
+  KdSplit split;                    ///< brick r belongs to rank r
+};
+
+/// Collective: rank 0 reads the layout (volume::read_vdb_layout) and splits it for size() ranks.
+DataParallelPlan plan_bricks(const std::string& path, const std::string& grid);
+
+struct BrickInput {
+  volume::Volume volume;    ///< this rank's brick plus ghosts
+  volume::GridInfo info;    ///< of the WHOLE grid: active count and boxes from the plan, value range agreed
+  std::uint64_t non_finite_voxels = 0;  ///< summed over ranks (ghosts may count twice)
+  RankStats stats;          ///< active_voxels_loaded and bytes_read filled
+};
+
+/// Collective: every rank reads its brick (a failure anywhere fails all ranks alike). `limit` is per rank: the
+/// brick's leaf-level voxel bound must fit it (ResourceError otherwise).
+BrickInput load_brick(const DataParallelPlan& plan, const std::string& path, const volume::LoadVdbOptions& options,
+                      const MemoryLimit& limit);
+
+struct DataParallelFrame {
+  ImageRGBA image;              ///< rank 0: composited over options.background; elsewhere empty
+  std::uint64_t samples = 0;    ///< summed over ranks
+  std::uint64_t visible_blocks = 0;  ///< summed over ranks (blocks near brick planes count on both sides)
+  double render_ms = 0, composite_ms = 0;  ///< this rank's
+};
+
+/// Collective: renders the segments of every ray inside this rank's brick (volume::SegmentClip, on the whole
+/// grid's sample lattice), composites the premultiplied images front to back by binary swap, and rank 0
+/// composites the result over the background.
+DataParallelFrame render_data_parallel(const DataParallelPlan& plan, const volume::Volume& brick,
+                                       const volume::TransferFunction& tf, const CameraSpec& camera,
+                                       volume::RenderOptions options);
+
+}  // namespace raysift::mpi
