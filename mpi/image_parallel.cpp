@@ -19,6 +19,7 @@
 namespace raysift::mpi {
 namespace {
 
+#if RAYSIFT_HAVE_MPI
 constexpr int kFloatsPerPixel = 5;  // composited RGBA and depth, as RenderResult holds them
 
 /// Traces one tile exactly as render_full does and writes its pixels, row-major, to `out` (kFloatsPerPixel
@@ -49,7 +50,6 @@ void place_tile(const TileGrid::Rect& r, const float* in, volume::RenderResult& 
     }
 }
 
-#if RAYSIFT_HAVE_MPI
 constexpr int kTagRequest = 19001, kTagTile = 19002, kTagTileList = 19003, kTagTileData = 19004;
 constexpr int kDepth = 2;  // requests each worker keeps outstanding
 
