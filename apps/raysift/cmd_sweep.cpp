@@ -174,10 +174,22 @@ struct PointSummary {
   std::size_t feature_triangles = 0;
 };
 
+/// Everything a rank needs to render its units.
+struct Study {
+  const SweepOptions& options;
+  const VolumeInput& input;
+  const sampling::TradeOptions& trade;
+  std::vector<StudyPoint> points;       ///< TF-major
+  std::vector<sampling::SweepUnit> units;
+  bool is_study = false;                ///< --tf-list or --camera-list: rows name their point
+};
+
 /// Renders this rank's units (ascending, so each study point's are consecutive) and returns their CSV texts.
-std::vector<std::string> run_units(const std::vector<std::size_t>& mine, const std::vector<sampling::SweepUnit>& units,
-                                   const std::vector<StudyPoint>& points, bool is_study, const SweepOptions& o,
-                                   const VolumeInput& in, const sampling::TradeOptions& trade, PointSummary& first) {
+std::vector<std::string> run_units(const std::vector<std::size_t>& mine, const Study& study, PointSummary& first) {
+  const SweepOptions& o = study.options;
+  const VolumeInput& in = study.input;
+  const sampling::TradeOptions& trade = study.trade;
+  const std::vector<sampling::SweepUnit>& units = study.units;
   volume::RenderOptions render;
   render.shading = o.shading == "phong" ? volume::Shading::Phong : volume::Shading::None;
   const sampling::SweepKnobs knobs{o.steps, o.early_terminations};
@@ -185,7 +197,7 @@ std::vector<std::string> run_units(const std::vector<std::size_t>& mine, const s
   const bool uses_features = !trade.features.classes.is_empty();
   std::vector<std::string> texts;
   for (std::size_t begin = 0; begin < mine.size();) {
-    const StudyPoint& p = points[units[mine[begin]].point];
+    const StudyPoint& p = study.points[units[mine[begin]].point];
     std::vector<sampling::SweepUnit> group;
     std::size_t end = begin;
     for (; end < mine.size() && units[mine[end]].point == units[mine[begin]].point; ++end) group.push_back(units[mine[end]]);
@@ -196,7 +208,7 @@ std::vector<std::string> run_units(const std::vector<std::size_t>& mine, const s
     if (group[0].point == 0) first = {geometry.build_ms, geometry.mesh.triangles.size()};
     for (const auto& rows : sampling::run_sweep_units(in.volume, *p.tf, caster, uses_features ? &geometry : nullptr,
                                                       trade, knobs, group))
-      texts.push_back(unit_csv(rows, is_study ? &p : nullptr));
+      texts.push_back(unit_csv(rows, study.is_study ? &p : nullptr));
     begin = end;
   }
   return texts;
@@ -209,17 +221,14 @@ void run(const SweepOptions& o, const CommonOptions& common) {
   if (!in.tf) throw InvalidInput(file_message(o.scene, "the scene has no 'transfer_function'"));
   const auto tfs = study_tfs(o, in);
   const auto cameras = study_cameras(o, in);
-  const bool is_study = !o.tf_list.empty() || !o.camera_list.empty();
-  std::vector<StudyPoint> points;
+  Study study{o, in, trade, {}, {}, !o.tf_list.empty() || !o.camera_list.empty()};
   for (const auto& [tf_name, tf] : tfs)
-    for (const auto& [camera_name, camera] : cameras) points.push_back({&tf, &camera, tf_name, camera_name});
-  const std::vector<sampling::SweepUnit> units =
-      sampling::sweep_units(points.size(), trade, sampling::SweepKnobs{o.steps, o.early_terminations});
+    for (const auto& [camera_name, camera] : cameras) study.points.push_back({&tf, &camera, tf_name, camera_name});
+  study.units = sampling::sweep_units(study.points.size(), trade, sampling::SweepKnobs{o.steps, o.early_terminations});
 
   PointSummary first;
-  const std::vector<std::string> texts = mpi::deal_and_gather(units.size(), [&](const std::vector<std::size_t>& mine) {
-    return run_units(mine, units, points, is_study, o, in, trade, first);
-  });
+  const std::vector<std::string> texts = mpi::deal_and_gather(
+      study.units.size(), [&](const std::vector<std::size_t>& mine) { return run_units(mine, study, first); });
   mpi::RankStats mine;
   mine.active_voxels_loaded = in.info.active_voxels;  // every rank holds the whole volume
   mine.render_ms = timer.elapsed_ms();
@@ -229,7 +238,7 @@ void run(const SweepOptions& o, const CommonOptions& common) {
   if (!mpi::is_root()) return;
 
   const std::string header = sampling::trade_csv({});
-  std::string csv = is_study ? header.substr(0, header.size() - 1) + ",tf,camera\n" : header;
+  std::string csv = study.is_study ? header.substr(0, header.size() - 1) + ",tf,camera\n" : header;
   for (const std::string& t : texts) csv += t;
   write_text_file(o.out, csv);
   if (!common.quiet) std::cout << csv;
@@ -241,7 +250,7 @@ void run(const SweepOptions& o, const CommonOptions& common) {
                 {"height", camera.height},
                 {"features_setup_ms", first.features_setup_ms},
                 {"feature_triangles", first.feature_triangles}};
-  if (is_study) stats["study_points"] = points.size();
+  if (study.is_study) stats["study_points"] = study.points.size();
   stats.merge_patch(ranks);
   write_stats_if_requested(common, stats);
 }
