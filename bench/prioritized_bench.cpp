@@ -262,7 +262,7 @@ struct SceneRun {
   // The budgets are shares of a full frame timed just before each budget's frames: on a shared machine the
   // scene's first full frame can be minutes old.
   void budget_table() const {
-    std::printf("budget mode (%d frames each, budget-aware importance, prior cost model): budget_ms p50_ms p95_ms "
+    std::printf("budget mode (%d frames each, budget-aware importance, cost fitted to the frames with lines): budget_ms p50_ms p95_ms "
                 "p95/budget mean_rays level0_only lines_skipped [full frame just before]\n", setup.budget_frames);
     for (double share : {0.1, 0.2, 0.4, 0.8}) {
       sampling::SamplingOptions s = setup.sampling;
@@ -272,9 +272,12 @@ struct SceneRun {
       double rays = 0;
       sampling::BudgetReserve reserve;  // learned from the previous frames of this budget
       int level0_only = 0, lines_skipped = 0;
+      sampling::FeatureOptions features = setup.features;  // its lines cost fitted to the frames with lines
       for (int k = 0; k < setup.budget_frames; ++k) {
         s.reconstruct_reserve_ms = reserve.next_ms();
-        const sampling::VolumeFrame f = sampling::render_volume_frame(caster, &geometry, setup.features, s);
+        const sampling::VolumeFrame f = sampling::render_volume_frame(caster, &geometry, features, s);
+        if (!f.lines_skipped)
+          features.lines_cost = features.lines_cost.fitted(f.importance_ms, geometry.mesh.triangles.size(), full.size());
         times.push_back(f.total_ms);
         rays += double(f.sampled.rays_traced);
         level0_only += f.sampled.budget_too_small;

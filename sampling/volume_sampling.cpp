@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 
 #include "core/errors.h"
 #include "core/parallel.h"
@@ -37,6 +38,13 @@ FeatureGeometry feature_geometry_for(const volume::Volume& volume, const volume:
 features::LineClassSet parse_feature_list(const std::string& list) {
   if (list == "none") return {};
   return features::parse_line_classes(list);
+}
+
+LinesCost LinesCost::fitted(double measured_ms, std::size_t triangles, std::size_t frame_pixels) const {
+  const double predicted = predict_ms(triangles, frame_pixels);
+  if (!(measured_ms > 0 && std::isfinite(measured_ms) && predicted > 0)) return *this;
+  const double k = measured_ms / predicted;
+  return {ms_per_mega_triangle * k, ms_per_mega_pixel * k};
 }
 
 bool lines_fit_budget(double lines_ms, double budget_ms, double max_share) {

@@ -37,6 +37,9 @@ struct LinesCost {
   double predict_ms(std::size_t triangles, std::size_t frame_pixels) const {
     return 1e-6 * (ms_per_mega_triangle * double(triangles) + ms_per_mega_pixel * double(frame_pixels));
   }
+  /// Both terms scaled so that the prediction for this frame is `measured_ms` (the machine's speed and load
+  /// now); unchanged for a non-positive or non-finite measurement.
+  LinesCost fitted(double measured_ms, std::size_t triangles, std::size_t frame_pixels) const;
 };
 
 /// Which lines drive the importance and how they are rasterised.

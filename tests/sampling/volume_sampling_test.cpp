@@ -136,6 +136,11 @@ TEST(VolumeSampling, LinesFitBudgetRule) {
   EXPECT_FALSE(lines_fit_budget(0.01, 100, 0)) << "share 0: never lines in budget mode";
   const LinesCost cost{60, 5};
   EXPECT_DOUBLE_EQ(cost.predict_ms(1000000, 2000000), 70.0);
+  const LinesCost slow = cost.fitted(140, 1000000, 2000000);
+  EXPECT_DOUBLE_EQ(slow.predict_ms(1000000, 2000000), 140.0);
+  EXPECT_DOUBLE_EQ(slow.predict_ms(0, 1000000), 10.0) << "both terms scale together";
+  EXPECT_DOUBLE_EQ(cost.fitted(std::nan(""), 1000000, 2000000).ms_per_mega_triangle, 60.0);
+  EXPECT_DOUBLE_EQ(cost.fitted(0, 1000000, 2000000).ms_per_mega_pixel, 5.0);
 }
 
 // A budget too small for the lines' predicted cost gives exactly the control frame (no geometry); a budget
@@ -166,7 +171,9 @@ TEST(VolumeSampling, BudgetTooSmallForTheLinesGivesTheControlFrame) {
   EXPECT_EQ(skipped.sampled.rays_traced, control.sampled.rays_traced);
   EXPECT_EQ(skipped.sampled.traced.pixels, control.sampled.traced.pixels);
   for (std::size_t i = 0; i < control.image.size(); ++i) ASSERT_EQ(skipped.image.pixels[i], control.image.pixels[i]);
-  EXPECT_FALSE(budgeted(&torus_geometry(), 1e12).lines_skipped);
+  const VolumeFrame with_lines = budgeted(&torus_geometry(), 1e12);
+  EXPECT_FALSE(with_lines.lines_skipped);
+  EXPECT_NE(with_lines.sampled.traced.pixels, control.sampled.traced.pixels) << "the lines must change the frame";
   FeatureOptions features = contour_features();
   features.lines_cost = {1e6, 0};
   EXPECT_FALSE(render_volume_frame(caster, &torus_geometry(), features, sampling(SamplingMode::Prioritized, 0.3))
