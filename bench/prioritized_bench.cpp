@@ -11,7 +11,7 @@
 // the smoke VDB from the shared datasets (bench/bench_data.h) with a TF written once (normalised to its value range) and never tuned.
 // Usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--linear] [--floor F] [--line-weight W]
 //                          [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N] [--budget-only]
-//                          [--guide-only] [--spacing S]
+//                          [--spacing S] [--max-budget-share K]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -24,7 +24,6 @@
 #include "bench/bench_data.h"
 #include "core/json_io.h"
 #include "core/timer.h"
-#include "features/raster.h"
 #include "sampling/trade.h"
 #include "volume/transfer_function.h"
 #include "volume/vdb_io.h"
@@ -116,7 +115,6 @@ struct Setup {
   int budget_frames = 10;
   int overhead_only = 0;  ///< > 0: only the overhead table, repeated this many times (for a profiler)
   bool budget_only = false;  ///< only the budget table (engine opaque)
-  bool guide_only = false;   ///< only the guided-reconstruction table
 };
 
 struct Scene {
@@ -232,6 +230,16 @@ struct SceneRun {
       print_ratio_row("prioritized, today's imp.", share, today, error_at_time(curve, today.ms), full_ms);
       print_ratio_row("prioritized, imp. at 5%", share, cheap, error_at_time(curve, cheap.ms), full_ms);
       print_ratio_row("control (no lines)", share, ctrl, error_at_time(curve, ctrl.ms), full_ms);
+      // The budget-aware rule (render_volume_frame): lines only if their cost fits the share of the budget.
+      // It picks one of the two rows above; the lines' measured cost is what a caller with history predicts.
+      const double lines_only_ms = std::max(0.0, lines_ms - bg_ms);
+      const bool with_lines = sampling::lines_fit_budget(lines_only_ms, s.budget_ms, setup.features.max_budget_share);
+      const TimedError& picked = with_lines ? today : ctrl;
+      print_ratio_row(with_lines ? "budget-aware (lines)" : "budget-aware (no lines)", share, picked,
+                      error_at_time(curve, picked.ms), full_ms);
+      std::printf("    lines cost %.1f ms = %.1f%% of the budget (rule: <= %.0f%%; prior model predicts %.1f ms)\n",
+                  lines_only_ms, 100 * lines_only_ms / s.budget_ms, 100 * setup.features.max_budget_share,
+                  setup.features.lines_cost.predict_ms(geometry.mesh.triangles.size(), full.size()));
     }
   }
 
@@ -250,35 +258,12 @@ struct SceneRun {
     }
   }
 
-  // The edge-aware guide (reconstruction.h) at equal rays: a full-resolution depth raster of the feature mesh.
-  void guide_table() const {
-    const Timer t;
-    const ImageF depth = features::rasterize_depth(geometry.mesh, caster.camera()).depth;
-    const double raster_ms = t.elapsed_ms();
-    std::printf("guided reconstruction (depth raster of the feature mesh, %.1f ms = %.1f%% of the full frame): "
-                "fraction, guided/unguided FLIP 1-SSIM 1-SSIMlin\n", raster_ms, 100 * raster_ms / full_ms);
-    for (double f : {0.03, 0.1, 0.2, 0.4}) {
-      sampling::SamplingOptions s = setup.sampling;
-      s.ray_fraction = f;
-      const Error plain = frame(lines, 0, s).error;
-      s.guide.depth = &depth;
-      std::printf("  %.2f", f);
-      for (float tolerance : {0.02f, 0.1f, 0.3f}) {
-        s.guide.relative_tolerance = tolerance;
-        const Error guided = frame(lines, 0, s).error;
-        std::printf("   tolerance %.2f: %6.3f %6.3f %6.3f", tolerance, guided.flip / plain.flip,
-                    guided.dssim / plain.dssim, guided.dssim_linear / plain.dssim_linear);
-      }
-      std::printf("\n");
-    }
-  }
-
   // Budget mode through the real pipeline (importance included): whole frames against the budget.
   // The budgets are shares of a full frame timed just before each budget's frames: on a shared machine the
   // scene's first full frame can be minutes old.
   void budget_table() const {
-    std::printf("budget mode (%d frames each, today's importance): budget_ms p50_ms p95_ms p95/budget mean_rays "
-                "level0_only [full frame just before]\n", setup.budget_frames);
+    std::printf("budget mode (%d frames each, budget-aware importance, cost fitted to the frames with lines): budget_ms p50_ms p95_ms "
+                "p95/budget mean_rays level0_only lines_skipped [full frame just before]\n", setup.budget_frames);
     for (double share : {0.1, 0.2, 0.4, 0.8}) {
       sampling::SamplingOptions s = setup.sampling;
       const double full_now = min_ms(2, [&] { volume::render_full(caster); });
@@ -286,18 +271,23 @@ struct SceneRun {
       std::vector<double> times;
       double rays = 0;
       sampling::BudgetReserve reserve;  // learned from the previous frames of this budget
-      int level0_only = 0;
+      int level0_only = 0, lines_skipped = 0;
+      sampling::FeatureOptions features = setup.features;  // its lines cost fitted to the frames with lines
       for (int k = 0; k < setup.budget_frames; ++k) {
         s.reconstruct_reserve_ms = reserve.next_ms();
-        const sampling::VolumeFrame f = sampling::render_volume_frame(caster, &geometry, setup.features, s);
+        const sampling::VolumeFrame f = sampling::render_volume_frame(caster, &geometry, features, s);
+        if (!f.lines_skipped)
+          features.lines_cost = features.lines_cost.fitted(f.importance_ms, geometry.mesh.triangles.size(), full.size());
         times.push_back(f.total_ms);
         rays += double(f.sampled.rays_traced);
         level0_only += f.sampled.budget_too_small;
+        lines_skipped += f.lines_skipped;
         reserve.update(f.total_ms - f.importance_ms - f.sampled.trace_end_ms, f.total_ms, s.budget_ms);
       }
       const double p95 = percentile(times, 0.95);
-      std::printf("  %3.0f%% of full %8.0f %6.0f %6.0f %8.3f %9.0f %d [%.0f ms]\n", share * 100, s.budget_ms,
-                  percentile(times, 0.5), p95, p95 / s.budget_ms, rays / setup.budget_frames, level0_only, full_now);
+      std::printf("  %3.0f%% of full %8.0f %6.0f %6.0f %8.3f %9.0f %d %d [%.0f ms]\n", share * 100, s.budget_ms,
+                  percentile(times, 0.5), p95, p95 / s.budget_ms, rays / setup.budget_frames, level0_only,
+                  lines_skipped, full_now);
     }
   }
 };
@@ -312,10 +302,6 @@ void run_scene(const Scene& sc, const Setup& setup, int width, int height, bool 
   for (int k = 1; k < setup.overhead_only; ++k) run.overhead();
   run.overhead();
   if (setup.overhead_only > 0) return;
-  if (setup.guide_only) {
-    run.guide_table();
-    return;
-  }
   if (setup.budget_only) {
     if (budget_table) run.budget_table();
     return;
@@ -354,11 +340,11 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--budget-frames") && more) setup.budget_frames = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--overhead-only") && more) setup.overhead_only = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--budget-only")) setup.budget_only = true;
-    else if (!std::strcmp(argv[i], "--guide-only")) setup.guide_only = true;
     else if (!std::strcmp(argv[i], "--spacing") && more) setup.sampling.base_spacing = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--max-budget-share") && more) setup.features.max_budget_share = std::stod(argv[++i]);
     else {
       std::fprintf(stderr, "usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--linear] [--floor F] "
-                           "[--line-weight W] [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N] [--budget-only] [--guide-only] [--spacing S]\n");
+                           "[--line-weight W] [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N] [--budget-only] [--spacing S] [--max-budget-share K]\n");
       return 2;
     }
   }

@@ -319,12 +319,14 @@ struct PathState {
   std::unique_ptr<RayCache> cache;
   std::unique_ptr<FractalPattern> pattern;
   ImageF still_importance;  // importance of the first frame since the camera stopped
+  LinesCost lines_cost;     // fitted to the path's frames with lines
   float alpha00;
   int still_frames = 0;     // frames since the camera stopped, after the first
   FrameTiming last_timing;
 
   explicit PathState(const PathRenderOptions& o)
-      : options(o), controller(make_controller(o)), alpha00(o.sampling.mapping.alpha[0]) {}
+      : options(o), controller(make_controller(o)), lines_cost(o.features.lines.lines_cost),
+        alpha00(o.sampling.mapping.alpha[0]) {}
 };
 
 /// A full frame: rendered once per camera; a still camera has nothing left to refine.
@@ -369,9 +371,19 @@ ImageRGBA sampled_frame(const volume::RayCaster& caster, const FeatureGeometry* 
     st.cache = std::make_unique<RayCache>(w, h);
     if (!st.pattern || st.pattern->level.width != w || st.pattern->level.height != h)
       st.pattern = std::make_unique<FractalPattern>(make_fractal_pattern(w, h, options.sampling.base_spacing));
-    st.still_importance = path_frame_importance(caster, geometry, options.features, st.previous ? &*st.previous : nullptr,
-                                                options.sampling.base_spacing, &frame.saliency_ms);
+    // Budget-aware lines (volume_sampling.h): the frame time is the target's or the budget.
+    const double frame_budget_ms = options.target_fps > 0 ? 1000.0 / options.target_fps : options.sampling.budget_ms;
+    const std::size_t triangles = geometry ? geometry->mesh.triangles.size() : 0, pixels = std::size_t(w) * std::size_t(h);
+    frame.lines_skipped = geometry != nullptr && !options.features.lines.classes.is_empty() &&
+                          options.sampling.mode == SamplingMode::Prioritized &&
+                          !lines_fit_budget(st.lines_cost.predict_ms(triangles, pixels), frame_budget_ms,
+                                            options.features.lines.max_budget_share);
+    st.still_importance = path_frame_importance(caster, frame.lines_skipped ? nullptr : geometry, options.features,
+                                                st.previous ? &*st.previous : nullptr, options.sampling.base_spacing,
+                                                &frame.saliency_ms);
     frame.importance_ms = clock.elapsed_ms();
+    if (geometry != nullptr && !frame.lines_skipped)
+      st.lines_cost = st.lines_cost.fitted(frame.importance_ms - frame.saliency_ms, triangles, pixels);
   }
   SamplingOptions so = options.sampling;
   if (so.mode == SamplingMode::Prioritized) {

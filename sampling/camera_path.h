@@ -102,6 +102,8 @@ struct PathFrame {
   std::size_t full_rays = 0;    ///< rays of the full render of this view
   float alpha00 = 0;            ///< α00 used (target-fps: the controller's choice)
   bool refined = false;         ///< same camera as before: previous rays kept, refinement continued
+  /// The frame time (1000 / target_fps, or the budget) left no room for the lines (lines_fit_budget).
+  bool lines_skipped = false;
   double ssim_vs_full = std::numeric_limits<double>::quiet_NaN();  ///< when compare_full
 };
 

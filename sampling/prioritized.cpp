@@ -201,10 +201,6 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
   const ObjectCounts counts = scan_importance(importance, options.base_spacing);
   const ElapsedMs now = options.clock_ms ? options.clock_ms : ElapsedMs([&clock] { return clock.elapsed_ms(); });
   const int w = importance.width, h = importance.height;
-  if (options.guide.depth && (options.guide.depth->width != w || options.guide.depth->height != h))
-    throw InvalidInput("reconstruction guide is " + std::to_string(options.guide.depth->width) + "x" +
-                       std::to_string(options.guide.depth->height) + ", the frame " + std::to_string(w) + "x" +
-                       std::to_string(h));
   SampledFrame frame;
   frame.image = ImageRGBA(w, h);
   frame.traced = ImageMask(w, h, 0);
@@ -252,7 +248,7 @@ SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, c
   stage.reset();
   if (frame.rays_traced < counts.object) {
     if (known.pixels.empty()) known = background_known(importance, &frame.traced);
-    reconstruct_fractal(frame.image, known, pattern, options.interpolation, options.guide);
+    reconstruct_fractal(frame.image, known, pattern, options.interpolation);
   }
   frame.reconstruct_ms = stage.elapsed_ms();
   return frame;

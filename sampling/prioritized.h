@@ -40,9 +40,6 @@ struct SamplingOptions {
   RefinementOptions refinement;
   /// How the prioritized modes fill untraced pixels (reconstruction.h).
   Interpolation interpolation = Interpolation::Cubic;
-  /// Optional edge-aware guide of the prioritized reconstruction (not owned; off by default, see
-  /// docs/prioritized.md for what it measured).
-  ReconstructionGuide guide;
   int base_spacing = 8;   ///< fractal level-0 spacing, px (power of two)
   int buckets = 256;      ///< priority buckets of the budget/progressive queue
   std::uint64_t seed = 1;

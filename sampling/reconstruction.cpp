@@ -155,45 +155,15 @@ kInline bool four_columns(const std::vector<std::uint8_t>& columns, int i) {
                                                    columns[std::size_t(i + 1)] & columns[std::size_t(i + 2)]);
 }
 
-// The guide's weight of each of the first n corners for pixel (x, y); false when all are on its surface (the
-// unguided rule applies).
-bool guide_weights(const ReconstructionGuide& guide, int x, int y, const std::array<Corner, 4>& c, int n,
-                   std::array<float, 4>& weight) {
-  if (!guide.depth) return false;
-  const float d = (*guide.depth)(x, y);
-  bool all_same = true;
-  for (int i = 0; i < n; ++i) {
-    const float di = (*guide.depth)(c[i].x, c[i].y);
-    // Both empty (+inf) is one surface; otherwise compare relative to the nearer depth.
-    const bool same = di == d || std::abs(di - d) <= guide.relative_tolerance * std::min(di, d);
-    weight[i] = same ? 1.0f : guide.other_surface_weight;
-    all_same = all_same && same;
-  }
-  return !all_same;
-}
-
-Rgba weighted_mean_of(const ImageRGBA& image, const std::array<Corner, 4>& corners, const std::array<float, 4>& w,
-                      int n) {
-  Rgba sum;
-  float total = 0;
-  for (int i = 0; i < n; ++i) {
-    const Rgba& p = image(corners[i].x, corners[i].y);
-    sum = {sum.r + w[i] * p.r, sum.g + w[i] * p.g, sum.b + w[i] * p.b, sum.a + w[i] * p.a};
-    total += w[i];
-  }
-  const float inv = 1.0f / total;
-  return clamp01({sum.r * inv, sum.g * inv, sum.b * inv, sum.a * inv});
-}
-
 // Coarse to fine over square cells of spacing s = S, S/2, ..., 2 whose corners are available: the centre
 // gets the mean of the corners, then each edge midpoint the mean of its two ends, or, where both squares
 // beside it have a traced centre, the mean of those four diamond parents. Midpoint averaging evaluates the
 // bilinear interpolant at the dyadic points, so a flat region gets exactly the bilinear cell of its finest
 // complete lattice, and traced pixels of finer levels feed the cells below them without seams. With
-// Interpolation::Cubic the 4-point rule replaces the means wherever its wider stencil is available; with a
-// guide, parents across a depth edge are down-weighted (guide_weights). O(1) per pixel.
+// Interpolation::Cubic the 4-point rule replaces the means wherever its wider stencil is available. O(1) per
+// pixel.
 void fill_hierarchically(ImageRGBA& image, const ImageMask& known, ImageMask& available, int spacing,
-                         Interpolation interpolation, const ReconstructionGuide& guide) {
+                         Interpolation interpolation) {
   const int w = image.width, h = image.height;
   const bool cubic = interpolation == Interpolation::Cubic;
   for (int s = spacing; s >= 2; s /= 2) {
@@ -210,9 +180,7 @@ void fill_hierarchically(ImageRGBA& image, const ImageMask& known, ImageMask& av
         const std::array<Corner, 4> c{Corner{x0, y0, 0}, Corner{x0 + s, y0, 0}, Corner{x0, y0 + s, 0},
                                       Corner{x0 + s, y0 + s, 0}};
         Rgba& out = image(x0 + g, y0 + g);
-        std::array<float, 4> weight;
-        if (guide_weights(guide, x0 + g, y0 + g, c, 4, weight)) out = weighted_mean_of(image, c, weight, 4);
-        else if (cubic && four_columns(quad, i)) out = cubic_centre(image, x0, y0, s);
+        if (cubic && four_columns(quad, i)) out = cubic_centre(image, x0, y0, s);
         else out = mean_of(image, c, 4);
         available(x0 + g, y0 + g) = 1;
       }
@@ -236,9 +204,7 @@ void fill_hierarchically(ImageRGBA& image, const ImageMask& known, ImageMask& av
         const bool diamond = traced_centre(c[2].x, c[2].y) && traced_centre(c[3].x, c[3].y);
         const int n = diamond ? 4 : 2;
         Rgba& out = image(x, y);
-        std::array<float, 4> weight;
-        if (guide_weights(guide, x, y, c, n, weight)) out = weighted_mean_of(image, c, weight, n);
-        else if (!diamond && cubic && (horizontal ? four_columns(ends, k) : taps[std::size_t(k)]))
+        if (!diamond && cubic && (horizontal ? four_columns(ends, k) : taps[std::size_t(k)]))
           out = cubic_1d(image, x, y, dx, dy);
         else out = mean_of(image, c, n);
         available(x, y) = 1;
@@ -252,14 +218,13 @@ void fill_hierarchically(ImageRGBA& image, const ImageMask& known, ImageMask& av
 }  // namespace
 
 void reconstruct_fractal(ImageRGBA& image, const ImageMask& known, const FractalPattern& pattern,
-                         Interpolation interpolation, const ReconstructionGuide& guide) {
+                         Interpolation interpolation) {
   const int w = image.width, h = image.height, spacing = pattern.base_spacing;
   RAYSIFT_CHECK(known.width == w && known.height == h);
   RAYSIFT_CHECK(pattern.level.width == w && pattern.level.height == h);
-  RAYSIFT_CHECK(!guide.depth || (guide.depth->width == w && guide.depth->height == h));
 
   ImageMask available = known;
-  fill_hierarchically(image, known, available, spacing, interpolation, guide);
+  fill_hierarchically(image, known, available, spacing, interpolation);
 
   // Pass 2: what the hierarchy could not reach (cells crossing the right/bottom border, missing level-0
   // pixels) from the finest complete cell. Reads only `available` pixels.

@@ -24,19 +24,8 @@ namespace raysift::sampling {
 /// available, clamped to the cell's corner range (sharper shading, no ringing at edges).
 enum class Interpolation { Linear, Cubic };
 
-/// Optional edge-aware guide (issue 13 item 3): a per-pixel depth raster of the feature mesh (+inf where it is
-/// empty). A parent whose guide depth differs from the pixel's by more than `relative_tolerance` x the pixel's
-/// depth lies on another surface and gets `other_surface_weight` in the hierarchical means (a joint-bilateral
-/// rule with a box range kernel), so a depth edge stays sharp where no ray was traced. Where all parents are on
-/// the pixel's surface the rule is the unguided one, so an affine image is reproduced exactly there.
-struct ReconstructionGuide {
-  const ImageF* depth = nullptr;  ///< null = unguided; else the image's size
-  float relative_tolerance = 0.02f;
-  float other_surface_weight = 0.01f;
-};
-
 void reconstruct_fractal(ImageRGBA& image, const ImageMask& known, const FractalPattern& pattern,
-                         Interpolation interpolation = Interpolation::Linear, const ReconstructionGuide& guide = {});
+                         Interpolation interpolation = Interpolation::Linear);
 
 /// A regular sampling grid for the subsample baseline: pixel columns xs and rows ys (increasing).
 struct SampleGrid {

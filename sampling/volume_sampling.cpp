@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 
 #include "core/errors.h"
 #include "core/parallel.h"
@@ -32,6 +33,17 @@ FeatureGeometry feature_geometry_for(const volume::Volume& volume, const volume:
 features::LineClassSet parse_feature_list(const std::string& list) {
   if (list == "none") return {};
   return features::parse_line_classes(list);
+}
+
+LinesCost LinesCost::fitted(double measured_ms, std::size_t triangles, std::size_t frame_pixels) const {
+  const double predicted = predict_ms(triangles, frame_pixels);
+  if (!(measured_ms > 0 && std::isfinite(measured_ms) && predicted > 0)) return *this;
+  const double k = measured_ms / predicted;
+  return {ms_per_mega_triangle * k, ms_per_mega_pixel * k};
+}
+
+bool lines_fit_budget(double lines_ms, double budget_ms, double max_share) {
+  return !(budget_ms > 0) || lines_ms <= max_share * budget_ms;
 }
 
 ImageF frame_importance(const volume::RayCaster& caster, const FeatureGeometry* geometry,
@@ -91,7 +103,13 @@ VolumeFrame render_volume_frame(const volume::RayCaster& caster, const FeatureGe
   validate(sampling);
   const Timer total;
   VolumeFrame frame;
-  const ImageF importance = frame_importance(caster, geometry, features);
+  const bool has_lines = geometry != nullptr && !features.classes.is_empty();
+  const double budget = sampling.mode == SamplingMode::Prioritized ? sampling.budget_ms : 0.0;
+  frame.lines_skipped =
+      has_lines && !lines_fit_budget(features.lines_cost.predict_ms(geometry->mesh.triangles.size(),
+                                                                    std::size_t(caster.width()) * std::size_t(caster.height())),
+                                     budget, features.max_budget_share);
+  const ImageF importance = frame_importance(caster, frame.lines_skipped ? nullptr : geometry, features);
   frame.importance_ms = total.elapsed_ms();
   std::atomic<std::uint64_t> samples{0};
   frame.sampled = render_sampled(importance, caster_trace_batch(caster, &samples), sampling, frame.importance_ms);
@@ -139,6 +157,7 @@ SampledRender render_sampled_volume(const volume::Volume& volume, const volume::
   if (request.progressive_frames == 0) {
     VolumeFrame frame = render_volume_frame(caster, geometry_ptr, request.features, request.sampling);
     fill(frame.sampled, frame.importance_ms, frame.total_ms, frame.samples);
+    out.lines_skipped_for_budget = frame.lines_skipped;
     out.image = std::move(frame.image);
     return out;
   }

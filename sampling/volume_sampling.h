@@ -26,12 +26,37 @@ using isosurface::FeatureGeometry;
 using isosurface::FeatureGeometryOptions;
 using isosurface::load_feature_geometry;
 
+/// Predicted cost of the line importance (extraction, hidden-line z-buffer, raster, upsampling) of one frame.
+/// It is triangle-bound: the z-buffer of the visibility test costs the same at importance scales 0.25, 0.125
+/// and 0.0625 (docs/prioritized.md), so the model has a per-triangle and a per-frame-pixel term. The defaults
+/// are this project's measurements (bench/importance_bench, 2 cores); a caller with frame history scales them
+/// by what it measured (see VolumeFrame::lines_ms).
+struct LinesCost {
+  double ms_per_mega_triangle = 60;
+  double ms_per_mega_pixel = 5;
+  double predict_ms(std::size_t triangles, std::size_t frame_pixels) const {
+    return 1e-6 * (ms_per_mega_triangle * double(triangles) + ms_per_mega_pixel * double(frame_pixels));
+  }
+  /// Both terms scaled so that the prediction for this frame is `measured_ms` (the machine's speed and load
+  /// now); unchanged for a non-positive or non-finite measurement.
+  LinesCost fitted(double measured_ms, std::size_t triangles, std::size_t frame_pixels) const;
+};
+
 /// Which lines drive the importance and how they are rasterised.
 struct FeatureOptions {
   features::LineClassSet classes;  ///< empty = no features: the pattern-only control
   features::LineOptions lines;
   features::ImportanceOptions importance;
+  /// Budget mode (and camera paths with a target rate): the lines are computed only if their predicted cost
+  /// is at most this share of the frame time; otherwise the frame is the control (background only). [choice]
+  /// 0 = never in budget mode: the control beat the lines in 12 of 15 equal-time cells of the bench (FLIP; 5
+  /// scenes x 10/20/40 %) and in 10 of 15 at equal rays (docs/prioritized.md "Budget-aware importance").
+  double max_budget_share = 0;
+  LinesCost lines_cost;
 };
+
+/// The rule above: true when `lines_ms` fits `max_share` of `budget_ms` (always when no budget is set).
+bool lines_fit_budget(double lines_ms, double budget_ms, double max_share);
 
 /// \throw InvalidInput unless `list` is "none" or a --features class list (see features::parse_line_classes).
 features::LineClassSet parse_feature_list(const std::string& list);
@@ -50,6 +75,8 @@ struct VolumeFrame {
   SampledFrame sampled;   ///< counts, masks and times (its image is moved into `image` and composited)
   double importance_ms = 0;
   double total_ms = 0;    ///< importance + priorities + trace + reconstruct (wall)
+  /// The frame had line geometry but its budget left no room for the lines (lines_fit_budget).
+  bool lines_skipped = false;
   std::uint64_t samples = 0;  ///< volume samples taken by the traced rays
 };
 
@@ -109,6 +136,8 @@ struct SampledRender {
   std::vector<ProgressiveFrameStats> progressive;  ///< one per frame of a progressive render, else empty
   /// The TF is transparent over the whole data range: no surface feeds the lines, the frame used none.
   bool features_skipped = false;
+  /// The budget was too small for the lines' predicted cost: the frame used the control importance.
+  bool lines_skipped_for_budget = false;
 };
 
 /// True when volume::select_iso_values would find no surface (the TF hides every value the volume holds):

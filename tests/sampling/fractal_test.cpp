@@ -163,68 +163,6 @@ TEST(FractalReconstruction, AffineImageExactFromRandomSubsetsWithLevelZero) {
   }
 }
 
-// Level 0 of a w x h frame known with the values of `value`.
-template <typename F>
-void level0_known(const FractalPattern& p, const F& value, ImageRGBA& image, ImageMask& known) {
-  for (int y = 0; y < image.height; ++y)
-    for (int x = 0; x < image.width; ++x)
-      if (p.level(x, y) == 0) {
-        known(x, y) = 1;
-        image(x, y) = value(x, y);
-      }
-}
-
-TEST(GuidedReconstruction, FlatGuideIsTheUnguidedRuleAndAffineExact) {
-  const int w = 37, h = 29;
-  const FractalPattern p = make_fractal_pattern(w, h, 8);
-  const ImageF flat(w, h, 5.0f);
-  for (Interpolation mode : {Interpolation::Linear, Interpolation::Cubic}) {
-    ImageRGBA image(w, h, Rgba{9, 9, 9, 9});
-    ImageMask known(w, h, 0);
-    level0_known(p, affine, image, known);
-    ImageRGBA guided = image, plain = image;
-    reconstruct_fractal(guided, known, p, mode, ReconstructionGuide{&flat});
-    reconstruct_fractal(plain, known, p, mode);
-    expect_affine(guided, mode == Interpolation::Cubic ? "flat guide cubic" : "flat guide linear");
-    for (std::size_t i = 0; i < guided.size(); ++i) ASSERT_EQ(guided.pixels[i], plain.pixels[i]);
-  }
-}
-
-TEST(GuidedReconstruction, AffineExactWhereTheGuideIsFlatAndEdgesStaySharp) {
-  const int w = 64, h = 40, edge = 37;  // depth 10 left of the edge, 20 from it on (not on a lattice line)
-  const FractalPattern p = make_fractal_pattern(w, h, 8);
-  ImageF step(w, h, 10.0f);
-  for (int y = 0; y < h; ++y)
-    for (int x = edge; x < w; ++x) step(x, y) = 20.0f;
-  for (Interpolation mode : {Interpolation::Linear, Interpolation::Cubic}) {
-    // An affine image: exact on the left, beyond the reach of every stencil that crosses the edge (<= 28 px).
-    ImageRGBA image(w, h);
-    ImageMask known(w, h, 0);
-    level0_known(p, affine, image, known);
-    reconstruct_fractal(image, known, p, mode, ReconstructionGuide{&step});
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < edge - 28; ++x) ASSERT_NEAR(image(x, y).r, affine(x, y).r, 2e-6) << x << "," << y;
-    // A colour step on the guide's edge: guided pixels keep their side's colour (within the other-surface weight
-    // 0.01, compounded over the levels); the unguided rule blurs the step over a lattice cell.
-    const Rgba dark{0.1f, 0.1f, 0.1f, 1}, bright{0.9f, 0.9f, 0.9f, 1};
-    auto side = [&](int x, int) { return x < edge ? dark : bright; };
-    ImageRGBA guided(w, h), plain(w, h);
-    ImageMask known2(w, h, 0);
-    level0_known(p, side, guided, known2);
-    plain = guided;
-    reconstruct_fractal(guided, known2, p, mode, ReconstructionGuide{&step});
-    reconstruct_fractal(plain, known2, p, mode);
-    float guided_err = 0, plain_err = 0;
-    for (int y = 0; y < h - 8; ++y)  // the bottom rows fall back to border cells
-      for (int x = 0; x < 56; ++x) {
-        guided_err = std::max(guided_err, std::abs(guided(x, y).r - side(x, y).r));
-        plain_err = std::max(plain_err, std::abs(plain(x, y).r - side(x, y).r));
-      }
-    EXPECT_LT(guided_err, 0.05f * 0.8f);
-    EXPECT_GT(plain_err, 0.25f * 0.8f);
-  }
-}
-
 TEST(FractalReconstruction, KnownPixelsAreNeverChanged) {
   const int w = 40, h = 40;
   const FractalPattern p = make_fractal_pattern(w, h, 8);

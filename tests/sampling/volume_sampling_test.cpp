@@ -5,6 +5,7 @@
 #include <tbb/task_arena.h>
 
 #include <cmath>
+#include <memory>
 
 #include "volume/generate.h"
 
@@ -126,6 +127,57 @@ TEST(VolumeSampling, SameImageForOneAndTwoThreads) {
     });
   }
   for (std::size_t i = 0; i < images[0].size(); ++i) ASSERT_EQ(images[0].pixels[i], images[1].pixels[i]);
+}
+
+TEST(VolumeSampling, LinesFitBudgetRule) {
+  EXPECT_TRUE(lines_fit_budget(1e9, 0, 0.1)) << "no budget: always lines";
+  EXPECT_TRUE(lines_fit_budget(10, 100, 0.1));
+  EXPECT_FALSE(lines_fit_budget(10.01, 100, 0.1));
+  EXPECT_FALSE(lines_fit_budget(0.01, 100, 0)) << "share 0: never lines in budget mode";
+  const LinesCost cost{60, 5};
+  EXPECT_DOUBLE_EQ(cost.predict_ms(1000000, 2000000), 70.0);
+  const LinesCost slow = cost.fitted(140, 1000000, 2000000);
+  EXPECT_DOUBLE_EQ(slow.predict_ms(1000000, 2000000), 140.0);
+  EXPECT_DOUBLE_EQ(slow.predict_ms(0, 1000000), 10.0) << "both terms scale together";
+  EXPECT_DOUBLE_EQ(cost.fitted(std::nan(""), 1000000, 2000000).ms_per_mega_triangle, 60.0);
+  EXPECT_DOUBLE_EQ(cost.fitted(0, 1000000, 2000000).ms_per_mega_pixel, 5.0);
+}
+
+// A budget too small for the lines' predicted cost gives exactly the control frame (no geometry); a budget
+// they fit, or no budget, keeps the lines. The virtual clock advances per call, single-threaded, so both
+// budgeted frames launch the same rays when their importance is the same.
+TEST(VolumeSampling, BudgetTooSmallForTheLinesGivesTheControlFrame) {
+  const Fixture& f = fixture();
+  const volume::RayCaster caster(f.volume, f.tf, f.camera, f.options);
+  tbb::task_arena arena(1);
+  auto budgeted = [&](const FeatureGeometry* geometry, double share) {
+    SamplingOptions s = sampling(SamplingMode::Prioritized, 1.0);
+    s.budget_ms = 50;
+    s.reconstruct_reserve_ms = 0;
+    auto ticks = std::make_shared<double>(0.0);
+    s.clock_ms = [ticks] { return *ticks += 0.5; };
+    FeatureOptions features = contour_features();
+    features.max_budget_share = share;
+    features.lines_cost = {1e6, 0};  // 1 ms per triangle: far beyond any share of 50 ms
+    VolumeFrame frame;
+    arena.execute([&] { frame = render_volume_frame(caster, geometry, features, s); });
+    return frame;
+  };
+  const VolumeFrame skipped = budgeted(&torus_geometry(), 0.1), control = budgeted(nullptr, 0.1);
+  EXPECT_TRUE(skipped.lines_skipped);
+  EXPECT_FALSE(control.lines_skipped);
+  ASSERT_GT(skipped.sampled.rays_traced, 0u);
+  EXPECT_LT(skipped.sampled.rays_traced, skipped.sampled.full_rays) << "the clock must stop the frame early";
+  EXPECT_EQ(skipped.sampled.rays_traced, control.sampled.rays_traced);
+  EXPECT_EQ(skipped.sampled.traced.pixels, control.sampled.traced.pixels);
+  for (std::size_t i = 0; i < control.image.size(); ++i) ASSERT_EQ(skipped.image.pixels[i], control.image.pixels[i]);
+  const VolumeFrame with_lines = budgeted(&torus_geometry(), 1e12);
+  EXPECT_FALSE(with_lines.lines_skipped);
+  EXPECT_NE(with_lines.sampled.traced.pixels, control.sampled.traced.pixels) << "the lines must change the frame";
+  FeatureOptions features = contour_features();
+  features.lines_cost = {1e6, 0};
+  EXPECT_FALSE(render_volume_frame(caster, &torus_geometry(), features, sampling(SamplingMode::Prioritized, 0.3))
+                   .lines_skipped) << "no budget: the lines are always computed";
 }
 
 TEST(VolumeSampling, FeatureListParsing) {
