@@ -42,6 +42,8 @@ Json sampled_render_json(const sampling::SampledRender& r, double budget_ms) {
     stats["budget_ms"] = budget_ms;
     stats["budget_too_small"] = r.budget_too_small;
     stats["overshoot_ms"] = std::max(0.0, r.frame_ms - budget_ms);
+    // The budget rule (sampling::lines_fit_budget) traced with the background-only importance instead of the lines.
+    stats["lines_skipped_for_budget"] = r.lines_skipped_for_budget;
   }
   if (!r.progressive.empty()) {
     Json frames = Json::array();
@@ -63,7 +65,8 @@ Json path_stats_json(const std::vector<sampling::PathFrame>& frames, double targ
               {"rays_traced", f.rays_traced},
               {"full_rays", f.full_rays},
               {"alpha00", f.alpha00},
-              {"refined", f.refined}};
+              {"refined", f.refined},
+              {"lines_skipped", f.lines_skipped}};
     j["ssim_vs_full"] = std::isfinite(f.ssim_vs_full) ? Json(f.ssim_vs_full) : Json(nullptr);
     list.push_back(j);
   }
