@@ -4,7 +4,7 @@ protocol: loads the page, orbits with a mouse drag and checks the frame rate, dr
 image changes, waits for convergence and compares the canvas with `raysift render` of the same camera and TF
 (PNG: exact; JPEG: PSNR >= 40 dB), and saves a screenshot. Prints the latency and rate numbers the page measured.
 Bounded in time (--deadline) and kills the server and the browser it started, whatever happens."""
-import argparse, base64, io, json, math, os, re, shutil, signal, subprocess, sys, tempfile, time, urllib.request
+import argparse, base64, ctypes, json, math, os, re, shutil, signal, subprocess, sys, tempfile, time, urllib.request
 
 import numpy as np
 import websocket
@@ -13,6 +13,7 @@ from PIL import Image
 RATE_TOLERANCE = 0.15   # the issue: frames from one drag at the target rate +-15 %
 LATENCY_BUDGETS = 1.5   # the issue: camera message -> first pixels <= 1.5 x the frame budget
 JPEG_MIN_PSNR_DB = 40.0
+PR_SET_PDEATHSIG = 1
 
 
 class Failure(Exception):
@@ -31,9 +32,14 @@ class Deadline:
             raise Failure(f"out of time while {what}")
 
 
+def die_with_parent():
+    """Run in the child: SIGKILL it if this script dies (ctest's timeout kills without a chance to clean up)."""
+    ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
+
+
 def start(cmd, **kw):
     """A child in its own process group, so stop() also ends what it started (Chromium's helpers)."""
-    return subprocess.Popen(cmd, start_new_session=True, **kw)
+    return subprocess.Popen(cmd, start_new_session=True, preexec_fn=die_with_parent, **kw)
 
 
 def stop(proc):
