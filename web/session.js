@@ -50,7 +50,7 @@ export class Session {
       case "tf_applied": return this.handlers.tf_applied?.(msg);
       case "features_ready": return this.handlers.features_ready?.();
       case "error": return this.handlers.error?.(msg.message);
-      default: return this.handlers.error?.(`unknown message type '${msg.type}' from the server`);
+      default: return undefined;  // a newer server's message: the protocol only adds types
     }
   }
 

@@ -151,18 +151,18 @@ def wait_until(cdp, deadline, what, predicate, poll_s=0.1):
         time.sleep(poll_s)
 
 
-def wait_converged(cdp, deadline, what, quiet_s=0.4):
-    """Converged on the last camera and TF sent, and no further frame for quiet_s."""
+def wait_converged(cdp, deadline, what, quiet_s=0.5):
+    """Converged on the last camera and TF sent, and still so quiet_s later (a frame already under way when a
+    TF arrived may come after tf_applied; the new TF's first frames are not converged)."""
     def settled(s):
         return (s["connected"] and s["converged"] and s["camera"] is not None
                 and s["camera_seq"] == s["camera"]["seq"] and s["tf_applied"] == s["tf_sent"])
-    stats = wait_until(cdp, deadline, what, settled)
     while True:
+        first = wait_until(cdp, deadline, what, settled)
         time.sleep(quiet_s)
-        again = wait_until(cdp, deadline, what, settled)
-        if again["frames"] == stats["frames"]:
+        again = cdp.stats()
+        if settled(again) and again["tf_applied"] == first["tf_applied"]:
             return again
-        stats = again
 
 
 def canvas_pixels(cdp):
