@@ -201,8 +201,11 @@ def check_tf_edit(cdp, deadline):
     count = cdp.eval("window.raysift.tf_node_count()")
     # The densest opaque node of the bundled TFs sits in the middle; pulling it down changes the image.
     node = count // 2
+    cdp.eval("document.getElementById('tf-canvas').scrollIntoView({block: 'center'})")
     p = cdp.eval(f"window.raysift.tf_node_position({node})")
     cdp.drag((p["x"], p["y"]), (0, 60), seconds=0.5)
+    if cdp.stats()["tf_sent"] == 0:
+        raise Failure(f"dragging TF node {node} at ({p['x']:.0f}, {p['y']:.0f}) sent no TF message")
     stats = wait_converged(cdp, deadline, "waiting for convergence after the TF edit")
     after = canvas_pixels(cdp)
     changed = np.mean(np.any(before[..., :3] != after[..., :3], axis=2)) if before.shape == after.shape else 1.0
