@@ -1,6 +1,8 @@
 #include "server/viewer_session.h"
 
+#include <charconv>
 #include <chrono>
+#include <cstdlib>
 
 #include "core/camera.h"
 #include "core/errors.h"
@@ -39,9 +41,18 @@ Json iso_values_json(const volume::Histogram& histogram, const volume::TransferF
   return values;
 }
 
+/// The shortest decimal that reads back as `f`: 0.3f goes out as 0.3, not 0.30000001192092896, and a TF the page
+/// sends back unchanged is the same TF.
+double shortest(float f) {
+  char text[32];
+  const std::to_chars_result r = std::to_chars(text, text + sizeof text, f);
+  return std::strtod(std::string(text, r.ptr).c_str(), nullptr);
+}
+
 Json tf_json(const volume::TransferFunction& tf) {
   Json points = Json::array();
-  for (const volume::TfPoint& p : tf.points()) points.push_back({p.x, p.r, p.g, p.b, p.a});
+  for (const volume::TfPoint& p : tf.points())
+    points.push_back({p.x, shortest(p.r), shortest(p.g), shortest(p.b), shortest(p.a)});
   return {{"points", points}};
 }
 
