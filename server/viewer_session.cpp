@@ -7,6 +7,7 @@
 #include "core/camera.h"
 #include "core/errors.h"
 #include "core/timer.h"
+#include "server/jpeg_encoder.h"
 #include "volume/iso_values.h"
 
 namespace raysift::server {
@@ -14,6 +15,12 @@ namespace {
 
 const std::vector<std::string> kModes{"prioritized", "subsample", "full"};
 const std::vector<std::string> kShows{"image", "traced", "importance"};
+
+const std::vector<std::string>& image_formats() {
+  static const std::vector<std::string> formats =
+      jpeg_available() ? std::vector<std::string>{"png", "jpeg"} : std::vector<std::string>{"png"};
+  return formats;
+}
 
 std::string one_of(const Json& m, const char* key, const std::vector<std::string>& allowed) {
   const std::string v = m.at(key).get<std::string>();
@@ -96,9 +103,11 @@ Json ViewerSession::hello() const {
            {{"mode", view_.settings.mode},
             {"target_fps", view_.settings.target_fps},
             {"features", view_.settings.features},
-            {"show", view_.settings.show}}},
+            {"show", view_.settings.show},
+            {"format", view_.settings.format}}},
           {"iso_values", iso_values_json(h, view_.render->tf())},
-          {"image_format", "png"}};
+          {"image_format", view_.settings.format},
+          {"image_formats", image_formats()}};
 }
 
 void ViewerSession::on_text(const std::string& message) {
@@ -177,9 +186,7 @@ void ViewerSession::apply_settings(const Json& message) {
     s.features = message["features"].get<std::vector<std::string>>();
     static_cast<void>(sampling::parse_feature_list(join(s.features)));  // \throw InvalidInput naming the class
   }
-  if (message.contains("format") && message["format"] != "png")
-    throw InvalidInput("format must be \"png\" (the CLI's encoder; this server sends no JPEG), got " +
-                       message["format"].dump());
+  if (message.contains("format")) s.format = one_of(message, "format", image_formats());
   const std::lock_guard<std::mutex> lock(mutex_);
   view_.settings = s;
   ++view_.version;
@@ -192,6 +199,11 @@ bool ViewerSession::next_view(std::uint64_t rendered, bool converged, View& view
   if (stopping_) return false;
   view = view_;
   return true;
+}
+
+bool ViewerSession::superseded(std::uint64_t version) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  return view_.version != version;
 }
 
 void ViewerSession::render_loop() {
@@ -222,6 +234,7 @@ void ViewerSession::render_loop() {
     request.cancel = &cancel_;
     try {
       const RenderedFrame frame = is_new ? renderer.first_frame(request) : renderer.refine(request);
+      if (!is_new && superseded(rendered)) continue;  // a refinement of a view already left: not worth encoding
       const Timer send;
       if (!send_frame(frame, view, view.settings.mode == "full" ? 0.0 : budget_ms)) return;
       overhead_ms = 0.5 * (overhead_ms + send.elapsed_ms());  // smoothed: one slow send does not halve a budget
@@ -238,17 +251,19 @@ void ViewerSession::render_loop() {
 bool ViewerSession::send_frame(const RenderedFrame& frame, const View& view, double budget_ms) {
   std::string show = view.settings.show;
   if (show == "importance" && frame.importance.pixels.empty()) show = "traced";  // full frames have no importance
-  const std::vector<std::uint8_t> png = show == "image"     ? scene_.encoder->encode(frame.image)
-                                        : show == "traced" ? scene_.encoder->encode(frame.traced)
-                                                           : scene_.encoder->encode(frame.importance);
+  const bool jpeg = view.settings.format == "jpeg";
+  const ImageF& grey = show == "traced" ? frame.traced : frame.importance;
+  std::vector<std::uint8_t> bytes = show == "image" ? (jpeg ? encode_jpeg(frame.image) : scene_.encoder->encode(frame.image))
+                                                    : (jpeg ? encode_jpeg(grey) : scene_.encoder->encode(grey));
   const Json message = {{"type", "frame"},          {"seq", ++frame_seq_},
                         {"ms", frame.ms},           {"rays_traced", frame.rays_traced},
                         {"full_rays", frame.full_rays}, {"converged", frame.converged},
                         {"budget_ms", budget_ms},   {"show", show},
                         {"camera_seq", view.camera_seq}, {"mode", view.settings.mode},
-                        {"width", frame.image.width}, {"height", frame.image.height}};
+                        {"width", frame.image.width}, {"height", frame.image.height},
+                        {"format", view.settings.format}};
   sink_.text(message.dump());
-  return sink_.binary(png);
+  return sink_.binary(std::move(bytes));
 }
 
 void ViewerSession::geometry_loop() {

@@ -46,6 +46,7 @@ class ViewerSession : public ConnectionHandler {
     double target_fps = 10;
     std::vector<std::string> features{"contours", "silhouettes"};
     std::string show = "image";        ///< image | traced | importance
+    std::string format = "png";        ///< png (byte-equal to the CLI's) | jpeg (when jpeg_available())
   };
   /// What a frame is rendered from; every change bumps `version`.
   struct View {
@@ -67,6 +68,7 @@ class ViewerSession : public ConnectionHandler {
   void geometry_loop();
   /// Waits until the view changed, refinement is pending, or the session stops (then false).
   bool next_view(std::uint64_t rendered, bool converged, View& view);
+  bool superseded(std::uint64_t version);
   bool send_frame(const RenderedFrame& frame, const View& view, double budget_ms);
 
   const ServeScene& scene_;

@@ -2,11 +2,14 @@
 // come from outside the server: the files in web/, the CLI's own renders and PNGs, the volume read by the library.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <set>
 
+#include "core/colour.h"
 #include "core/image.h"
 #include "server/embedded_files.h"
 #include "tests/server/serve_client.h"
@@ -287,6 +290,43 @@ TEST(ServeProtocol, ShowTracedSendsTheTracedRayMask) {
     ones += p.r == 1.0f;
   }
   EXPECT_EQ(ones, f.header["rays_traced"].get<std::size_t>());
+}
+
+/// PSNR (dB) of two 8-bit images read from files, over their sRGB-encoded R, G, B values.
+double psnr_srgb(const std::string& a_path, const std::string& b_path) {
+  const ImageRGBA a = read_image_rgba(a_path), b = read_image_rgba(b_path);
+  EXPECT_EQ(a.width, b.width);
+  EXPECT_EQ(a.height, b.height);
+  double sum = 0;
+  for (std::size_t i = 0; i < a.size() && i < b.size(); ++i)
+    for (const auto channel : {&Rgba::r, &Rgba::g, &Rgba::b}) {
+      const double d = double(linear_to_srgb(a.pixels[i].*channel)) - double(linear_to_srgb(b.pixels[i].*channel));
+      sum += d * d;
+    }
+  const double mse = sum / (3.0 * double(a.size()));
+  return mse == 0 ? 1e9 : 10.0 * std::log10(1.0 / mse);
+}
+
+TEST(ServeProtocol, JpegFramesConvergeWithin40DbOfTheCliPng) {
+  const std::string dir = make_torus_dir("serve_jpeg");
+  ServeProcess server(dir, "torus.vdb --tf tf.json");
+  WsClient client(server.port());
+  const Json formats = client.hello()["image_formats"];
+  if (std::find(formats.begin(), formats.end(), "jpeg") == formats.end()) GTEST_SKIP() << "built without libjpeg";
+  client.send(Json{{"type", "settings"}, {"format", "jpeg"}});
+  Json camera = camera_message(client.hello(), 2, {30, -40, 60});
+  camera["width"] = 160;
+  camera["height"] = 120;
+  client.send(camera);
+  const ServeFrame f = client.read_converged(2);
+  EXPECT_EQ(f.header["format"], "jpeg");
+  ASSERT_GE(f.image.size(), 2u);
+  EXPECT_EQ(f.image.substr(0, 2), "\xff\xd8");  // the JPEG SOI marker
+  std::ofstream(dir + "/frame.jpg", std::ios::binary) << f.image;
+  const std::string cli = cli_png(dir, camera, "tf.json", "j");
+  const double psnr = psnr_srgb(dir + "/frame.jpg", dir + "/clij.png");
+  EXPECT_GE(psnr, 40.0);  // the bound for a JPEG canvas against the CLI's full render
+  RecordProperty("psnr_db", std::to_string(psnr));
 }
 
 TEST(ServeCli, SigtermStopsCleanlyAndWritesTheStats) {
