@@ -49,6 +49,8 @@ function on_hello(msg) {
   state.volume = msg.volume;
   state.camera = new OrbitCamera(msg.camera);
   state.settings = { format: msg.image_format || "png", ...msg.settings };
+  const formats = msg.image_formats || [state.settings.format];  // what this server can encode
+  for (const option of $("format").options) option.disabled = !formats.includes(option.value);
   show_settings();
   try {
     state.home_tf = tf_from_json(msg.transfer_function);
