@@ -101,8 +101,10 @@ export class Session {
 
   stats() {
     const last = this.last;
-    const n = this.draw_times.length;
-    const fps = n >= 2 ? ((n - 1) * 1000) / (this.draw_times[n - 1] - this.draw_times[0]) : null;
+    const now = performance.now();
+    const recent = this.draw_times.filter((t) => now - t <= RATE_WINDOW_MS);  // none once the server idles
+    const n = recent.length;
+    const fps = n >= 2 ? ((n - 1) * 1000) / (recent[n - 1] - recent[0]) : null;
     return {
       frames: this.frames,
       frame_ms: last ? last.ms : null,
