@@ -79,6 +79,10 @@ RegisterCommand reg(
           ->check(CLI::Range(0.1, 120.0))
           ->capture_default_str();
       add_non_finite_flag(sub, common);
+      sub.footer("Examples:\n  raysift serve --scene datasets/engine_ct_scene.json      # then open the printed URL\n"
+                 "  raysift serve volume.vdb --tf tf.json --port 0 --target-fps 20 --stats serve.json\n"
+                 "  raysift serve --scene s.json --host 0.0.0.0    # other machines too: no authentication\n"
+                 "Protocol and frame scheduling: docs/serve.md\n");
       return [o, &common] { serve(*o, common); };
     });
 
