@@ -262,7 +262,7 @@ def run(args, deadline, children, work):
     wait_until(cdp, deadline, "loading the page", lambda s: s["frames"] > 0)
     if args.format != "png":
         cdp.eval(f"(() => {{ const f = document.getElementById('format'); f.value = '{args.format}';"
-                 " f.dispatchEvent(new Event('change')); }})()")
+                 " f.dispatchEvent(new Event('change')); })()")
     rate_failure = check_orbit(cdp, deadline)
     wait_converged(cdp, deadline, "waiting for convergence after the orbit")
     pixels = check_tf_edit(cdp, deadline)
