@@ -67,12 +67,10 @@ def orbit_camera(hello_camera, t, seconds, width, height):
 def receive(ws, frames, stop):
     """Frames (arrival time, header, image bytes) until `stop` is set and the socket times out."""
     header = None
-    while True:
+    while not stop.is_set():  # refinement frames may keep coming long after the drag
         try:
             m = ws.recv()
         except websocket.WebSocketTimeoutException:
-            if stop.is_set():
-                return
             continue
         except websocket.WebSocketConnectionClosedException:
             return

@@ -238,7 +238,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
 class Listener {
  public:
   Listener(net::io_context& io, const HttpServerOptions& options, const HandlerFactory& factory)
-      : io_(io), acceptor_(io), signals_(io, SIGINT, SIGTERM), options_(options), factory_(factory) {
+      : io_(io), acceptor_(io), signals_(io, SIGINT, SIGTERM), linger_(io), options_(options), factory_(factory) {
     beast::error_code ec;
     const auto address = net::ip::make_address(options.host, ec);
     if (ec) throw InvalidInput("--host must be an IP address, got '" + options.host + "'");
@@ -275,12 +275,15 @@ class Listener {
     for (const std::weak_ptr<WsSession>& w : registry_)
       if (auto ws = w.lock()) ws->shut_down();
     registry_.clear();
-    io_.stop();
+    // A moment for the close frames to go out; idle keep-alive HTTP reads would keep run() going for ever.
+    linger_.expires_after(std::chrono::milliseconds(200));
+    linger_.async_wait([this](beast::error_code) { io_.stop(); });
   }
 
   net::io_context& io_;
   tcp::acceptor acceptor_;
   net::signal_set signals_;
+  net::steady_timer linger_;
   int signal_ = 0;
   const HttpServerOptions& options_;
   const HandlerFactory& factory_;

@@ -7,6 +7,7 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <set>
 
 #include "core/colour.h"
@@ -202,6 +203,21 @@ TEST(ServeProtocol, TfMessageIsAppliedItsFeaturesBuiltAndFramesConvergeToTheCliW
   EXPECT_EQ(client.read_converged(9).image, cli_png(dir, camera, "tf2.json", "t"));
 }
 
+TEST(ServeProtocol, ATransparentTfImpliesNoIsoValueAndFramesGoWithoutFeatures) {
+  const std::string dir = make_torus_dir("serve_tf_transparent");
+  ServeProcess server(dir, "torus.vdb --tf tf.json");
+  WsClient client(server.port());
+  client.send(Json{{"type", "tf"}, {"transfer_function", Json::parse(R"({"points": [[0,1,1,1,0],[1,1,1,1,0]]})")}});
+  EXPECT_EQ(client.read_type("tf_applied")["iso_values"], Json::array());
+  const Json ready = client.read_type("features_ready");
+  EXPECT_EQ(ready["triangles"], 0);
+  EXPECT_TRUE(ready.contains("warning"));
+  client.send(camera_message(client.hello(), 1));
+  const ServeFrame f = client.read_converged(1);
+  EXPECT_EQ(f.header["full_rays"], 0);  // nothing visible: every pixel is background
+  EXPECT_EQ(test::png_size(f.image), std::make_pair(48, 36));
+}
+
 TEST(ServeProtocol, MalformedAndUnknownMessagesGetAnErrorAndTheConnectionStays) {
   const std::string dir = make_torus_dir("serve_errors");
   ServeProcess server(dir, "torus.vdb --tf tf.json");
@@ -338,10 +354,13 @@ TEST(ServeCli, SigtermStopsCleanlyAndWritesTheStats) {
     client.read_converged(1);
     WsClient second(server.port());
   }
+  WsClient connected(server.port());  // reading its frames, as a page does, while the server stops
+  std::future<int> close_code = std::async(std::launch::async, [&connected] { return connected.read_close_code(); });
   EXPECT_EQ(server.stop(SIGTERM), 0) << server.stderr_text();
+  EXPECT_EQ(close_code.get(), 1001);  // going away, sent before the process ended
   const Json stats = read_json_file(dir + "/stats.json");
   EXPECT_GE(stats["frames_served"].get<int>(), 1);
-  EXPECT_EQ(stats["clients"]["total"], 2);
+  EXPECT_EQ(stats["clients"]["total"], 3);
   EXPECT_GE(stats["clients"]["max_concurrent"].get<int>(), 1);
   const Json& p = stats["frame_ms"]["prioritized"];
   EXPECT_GT(p["p50"].get<double>(), 0.0);
