@@ -44,7 +44,6 @@ function show_message(text, is_error = false) {
 }
 
 function on_hello(msg) {
-  $("connection").textContent = `connected, ${msg.image_format || "png"} frames`;
   $("volume-name").textContent = msg.volume.name;
   state.volume = msg.volume;
   state.camera = new OrbitCamera(msg.camera);
@@ -52,6 +51,12 @@ function on_hello(msg) {
   const formats = msg.image_formats || [state.settings.format];  // what this server can encode
   for (const option of $("format").options) option.disabled = !formats.includes(option.value);
   show_settings();
+  // [choice] JPEG frames when the server has them: PNG encoding takes most of a frame period (docs/serve-page.md);
+  // choose PNG for frames byte-equal to `raysift render -o x.png`.
+  if (formats.includes("jpeg") && state.settings.format !== "jpeg") {
+    $("format").value = "jpeg";
+    send_settings();
+  }
   try {
     state.home_tf = tf_from_json(msg.transfer_function);
   } catch (err) {
@@ -330,6 +335,7 @@ function update_labels() {
 
 function update_status() {
   const s = main_session.stats();
+  if (main_session.is_open() && state.settings) $("connection").textContent = `connected, ${state.settings.format} frames`;
   const target = state.settings ? state.settings.target_fps : null;
   $("st-frame").textContent = `${fmt(s.frame_ms, 1, " ms")} (budget ${fmt(s.budget_ms, 1, " ms")})`;
   $("st-fps").textContent = `${fmt(s.fps, 1, " fps")} (target ${fmt(target, 0)})`;
@@ -350,6 +356,7 @@ Object.defineProperty(window, "raysiftStats", {
     ...main_session.stats(),
     connected: main_session.is_open(),
     target_fps: state.settings ? state.settings.target_fps : null,
+    settings_format: state.settings ? state.settings.format : null,
     camera: state.last_camera,
     tf_sent: state.tf_sent, tf_applied: state.tf_applied, iso_values: state.iso_values,
     features_ready: state.features_ready, errors: state.errors.slice(-5),

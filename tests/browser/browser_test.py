@@ -260,12 +260,14 @@ def run(args, deadline, children, work):
              deviceScaleFactor=1, mobile=False)
     cdp.call("Page.navigate", url=url)
     wait_until(cdp, deadline, "loading the page", lambda s: s["frames"] > 0)
-    if args.format != "png":
+    if cdp.stats()["settings_format"] != args.format:
         cdp.eval(f"(() => {{ const f = document.getElementById('format'); f.value = '{args.format}';"
                  " f.dispatchEvent(new Event('change')); })()")
     rate_failure = check_orbit(cdp, deadline)
     wait_converged(cdp, deadline, "waiting for convergence after the orbit")
     pixels = check_tf_edit(cdp, deadline)
+    cdp.eval("document.getElementById('panel').scrollTop = 0")  # the status on screen, not the TF editor
+    time.sleep(0.3)  # one status refresh
     shot = cdp.call("Page.captureScreenshot", format="png")
     shot_path = os.path.join(args.out_dir, "browser_screenshot.png")
     with open(shot_path, "wb") as f:
@@ -282,7 +284,8 @@ def main():
     ap.add_argument("--chromium", default=shutil.which("chromium") or "chromium")
     ap.add_argument("--scene", default="datasets/engine_ct_scene.json")
     ap.add_argument("--out-dir", default="build")
-    ap.add_argument("--format", choices=["png", "jpeg"], default="png")
+    ap.add_argument("--format", choices=["png", "jpeg"], default="jpeg",
+                    help="frame format: png frames must equal the CLI's exactly, jpeg ones by PSNR >= 40 dB")
     ap.add_argument("--window", type=int, nargs=2, default=[1100, 680], metavar=("W", "H"))
     ap.add_argument("--deadline", type=float, default=55.0, help="seconds for the whole test")
     ap.add_argument("--server-arg", action="append", default=[], help="extra argument for raysift serve")
