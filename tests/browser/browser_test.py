@@ -286,8 +286,8 @@ def main():
     ap.add_argument("--out-dir", default="build")
     ap.add_argument("--format", choices=["png", "jpeg"], default="jpeg",
                     help="frame format: png frames must equal the CLI's exactly, jpeg ones by PSNR >= 40 dB")
-    ap.add_argument("--window", type=int, nargs=2, default=[1100, 680], metavar=("W", "H"))
-    ap.add_argument("--deadline", type=float, default=55.0, help="seconds for the whole test")
+    ap.add_argument("--window", type=int, nargs=2, default=[960, 600], metavar=("W", "H"))
+    ap.add_argument("--deadline", type=float, default=50.0, help="seconds for the whole test")
     ap.add_argument("--server-arg", action="append", default=[], help="extra argument for raysift serve")
     args = ap.parse_args()
     os.makedirs(args.out_dir, exist_ok=True)
