@@ -80,7 +80,11 @@ export class Session {
     this.record_latency(meta.camera_seq, now);
     this.draw_times.push(now);
     while (this.draw_times.length > 0 && now - this.draw_times[0] > RATE_WINDOW_MS) this.draw_times.shift();
-    if (this.drag && this.drag.active && meta.camera_seq >= this.drag.first_seq) this.drag.draws.push(now);
+    if (this.drag && this.drag.active && meta.camera_seq >= this.drag.first_seq) {
+      this.drag.draws.push(now);
+      this.drag.frame_ms.push(meta.ms);
+      this.drag.budget_ms.push(meta.budget_ms);
+    }
     this.handlers.frame?.(meta);
   }
 
@@ -96,7 +100,7 @@ export class Session {
   }
 
   /// A drag's frame rate counts the frames that reflect its camera messages, from the first to its end.
-  begin_drag(first_seq) { this.drag = { active: true, first_seq, draws: [] }; }
+  begin_drag(first_seq) { this.drag = { active: true, first_seq, draws: [], frame_ms: [], budget_ms: [] }; }
   end_drag() { if (this.drag) this.drag.active = false; }
 
   stats() {
@@ -132,6 +136,7 @@ export class Session {
       active: this.drag.active, frames: t.length,
       fps: t.length >= 2 ? ((t.length - 1) * 1000) / (t[t.length - 1] - t[0]) : null,
       interval_p50_ms: percentile(intervals, 50), interval_p95_ms: percentile(intervals, 95),
+      frame_ms_p50: percentile(this.drag.frame_ms, 50), budget_ms_p50: percentile(this.drag.budget_ms, 50),
     };
   }
 }
