@@ -73,9 +73,16 @@ function on_hello(msg) {
 }
 
 // --- camera -------------------------------------------------------------------------------------------
+/// The view's size in device pixels; in the split, the largest rectangle of the scene camera's aspect inside
+/// it, so that the two narrow halves keep the scene's framing instead of cropping its sides.
 function render_size() {
   const rect = $("main-view").getBoundingClientRect();
-  const w = rect.width * devicePixelRatio, h = rect.height * devicePixelRatio;
+  let w = rect.width * devicePixelRatio, h = rect.height * devicePixelRatio;
+  if (state.sub && state.camera.home.width > 0 && state.camera.home.height > 0) {
+    const aspect = state.camera.home.width / state.camera.home.height;
+    if (w / h < aspect) h = w / aspect;
+    else w = h * aspect;
+  }
   const s = Math.min(1, MAX_SIDE_PX / Math.max(w, h, 1));
   return [Math.max(16, Math.round(w * s)), Math.max(16, Math.round(h * s))];
 }
