@@ -17,7 +17,7 @@ const ZOOM_STEP = 1.1;
 const MODES = ["prioritized", "full", "subsample"];
 
 const state = {
-  camera: null, seq: 0, camera_scheduled: false, last_camera: null,
+  volume: null, camera: null, seq: 0, camera_scheduled: false, last_camera: null,
   settings: null, tf: null, home_tf: null, last_tf_preset: null, tf_timer: null, tf_pending: false,
   tf_sent: 0, tf_applied: 0, iso_values: [], features_ready: null, errors: [], sub: null,
 };

@@ -103,12 +103,15 @@ class Cdp:
         self.ws = websocket.create_connection(pages[0]["webSocketDebuggerUrl"], timeout=20,
                                               suppress_origin=True, enable_multithread=False)
         self.next_id = 0
+        self.exceptions = []  # uncaught page exceptions (Runtime.exceptionThrown), checked at the end
 
     def call(self, method, **params):
         self.next_id += 1
         self.ws.send(json.dumps({"id": self.next_id, "method": method, "params": params}))
         while True:
             msg = json.loads(self.ws.recv())
+            if msg.get("method") == "Runtime.exceptionThrown":
+                self.exceptions.append(msg["params"]["exceptionDetails"].get("exception", {}).get("description"))
             if msg.get("id") == self.next_id:
                 if "error" in msg:
                     raise Failure(f"{method}: {msg['error']}")
@@ -259,6 +262,7 @@ def run(args, deadline, children, work):
     cdp = Cdp(port, deadline)
     cdp.call("Emulation.setDeviceMetricsOverride", width=args.window[0], height=args.window[1],
              deviceScaleFactor=1, mobile=False)
+    cdp.call("Runtime.enable")
     cdp.call("Page.navigate", url=url)
     wait_until(cdp, deadline, "loading the page", lambda s: s["frames"] > 0)
     if cdp.stats()["settings_format"] != args.format:
@@ -275,6 +279,9 @@ def run(args, deadline, children, work):
         f.write(base64.b64decode(shot["data"]))
     print(f"screenshot: {shot_path}")
     check_against_cli(cdp, args, pixels, work)
+    cdp.call("Runtime.evaluate", expression="0")  # collects any exception events still queued
+    if cdp.exceptions:
+        raise Failure(f"uncaught exceptions in the page: {cdp.exceptions}")
     if rate_failure:
         raise Failure(rate_failure)
 
