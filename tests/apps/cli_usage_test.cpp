@@ -16,7 +16,7 @@ using test::CliRun;
 
 const std::string kDatasets = std::string(RAYSIFT_SOURCE_DIR) + "/datasets";
 const std::vector<std::string> kCommands = {"compare", "demo",   "import", "info",    "lines",   "make-scene", "make-volume",
-                                            "mesh",    "nrr",    "render", "saliency", "shadows", "sweep"};
+                                            "mesh",    "nrr",    "render", "saliency", "serve",   "shadows", "sweep"};
 
 TEST(CliUsage, UnknownCommandNamesTheNearestOne) {
   const std::string dir = test::make_temp_dir("cli_unknown");
@@ -53,7 +53,7 @@ TEST(CliUsage, EveryCommandHelpShowsExamplesAndDefaults) {
     EXPECT_EQ(r[i].code, 0) << kCommands[i];
     EXPECT_NE(r[i].out.find("Example"), std::string::npos) << kCommands[i] << "\n" << r[i].out;
   }
-  const CliRun shadows = r[11];
+  const CliRun shadows = r[12];
   EXPECT_NE(shadows.out.find("--light-samples INT:INT in [1 - 256]=16"), std::string::npos) << shadows.out;
   EXPECT_NE(shadows.out.find("--method ENUM:conventional|nrr|peel|raytrace|shadowmap=nrr"), std::string::npos);
   const CliRun render = r[9];

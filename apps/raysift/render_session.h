@@ -1,6 +1,7 @@
 #pragma once
-/// \file The render keywords and the session both raysift.render and raysift.Renderer use, so the two give the
-/// same (image, stats) by construction; py_tools.cpp's sweep reuses the keyword mapping.
+/// \file A persistent renderer's state and `raysift render`'s settings as a struct: the Python module
+/// (raysift.render, raysift.Renderer) and `raysift serve` render through it, so both give what the CLI gives
+/// for the same volume, TF, camera and settings by construction.
 #include <array>
 #include <atomic>
 #include <memory>
@@ -17,9 +18,9 @@
 #include "volume/transfer_function.h"
 #include "volume/volume.h"
 
-namespace raysift::py {
+namespace raysift::app {
 
-/// The keywords of raysift.render; defaults are the CLI's (RenderCliOptions).
+/// `raysift render`'s settings; defaults are the CLI's (RenderCliOptions).
 struct RenderKeywords {
   std::string mode = "full";  ///< full | prioritized | subsample
   std::optional<double> ray_fraction, budget_ms;
@@ -47,12 +48,19 @@ struct RenderOutput {
 class RenderSession {
  public:
   RenderSession(volume::Volume volume, volume::TransferFunction tf);
+  /// The same volume, bricks and feature cache under another TF (no brick rebuild).
+  RenderSession with_tf(volume::TransferFunction tf) const;
   /// One `raysift render` of this volume and TF; stops with Cancelled once `cancel` is set.
   RenderOutput render(const CameraSpec& camera, const RenderKeywords& k, const std::atomic<bool>& cancel) const;
+  /// The caster `render` uses for this camera. \throw InvalidInput for a bad camera or settings.
+  volume::RayCaster caster(const CameraSpec& camera, const RenderKeywords& k) const;
   const volume::Volume& volume() const { return volume_; }
   const volume::TransferFunction& tf() const { return tf_; }
+  isosurface::FeatureCache* feature_cache() const { return cache_.get(); }
 
  private:
+  RenderSession(volume::Volume volume, volume::TransferFunction tf, std::shared_ptr<const volume::VolumeBricks> bricks,
+                std::shared_ptr<isosurface::FeatureCache> cache);
   RenderOutput render_frame(const CameraSpec& camera, const RenderKeywords& k, const std::atomic<bool>& cancel) const;
 
   volume::Volume volume_;
@@ -61,4 +69,4 @@ class RenderSession {
   std::shared_ptr<isosurface::FeatureCache> cache_;  ///< memory only; thread-safe
 };
 
-}  // namespace raysift::py
+}  // namespace raysift::app

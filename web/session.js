@@ -1,0 +1,142 @@
+// One WebSocket session with `raysift serve` (docs/serve.md): the server's text messages, the frame
+// header + binary image pairs drawn onto a canvas, and the numbers the status shows. The page opens one
+// session for the main view and, for the split view, a second one in subsample mode.
+
+const RATE_WINDOW_MS = 1000;
+const LATENCY_KEEP = 500;
+
+export function percentile(values, p) {
+  if (values.length === 0) return null;
+  const sorted = [...values].sort((a, b) => a - b);
+  return sorted[Math.min(sorted.length - 1, Math.floor((p / 100) * sorted.length))];
+}
+
+export class Session {
+  /// handlers: hello(msg), frame(meta), tf_applied(msg), features_ready(), error(text), closed(text).
+  constructor(url, canvas, handlers) {
+    this.canvas = canvas;
+    this.handlers = handlers;
+    this.pending_meta = null;
+    this.draw_chain = Promise.resolve();
+    this.sent_camera = new Map();    // seq -> performance.now() when sent, until a frame reflects it
+    this.latencies_ms = [];          // camera message -> first pixels drawn that reflect it
+    this.draw_times = [];            // performance.now() of recent draws, for the achieved rate
+    this.drag = null;                // {start, draws: [t...]} while (or after) the user drags
+    this.frames = 0;
+    this.last = null;                // the last drawn frame's header
+    this.ws = new WebSocket(url);
+    this.ws.binaryType = "blob";
+    this.ws.onmessage = (e) => this.receive(e.data);
+    this.ws.onclose = (e) => handlers.closed?.(`connection closed (${e.code}${e.reason ? ": " + e.reason : ""})`);
+  }
+
+  is_open() { return this.ws.readyState === WebSocket.OPEN; }
+
+  send(message) {
+    if (!this.is_open()) return;
+    if (message.type === "camera" && message.seq !== undefined) this.sent_camera.set(message.seq, performance.now());
+    this.ws.send(JSON.stringify(message));
+  }
+
+  close() { this.ws.onclose = null; this.ws.close(); }
+
+  receive(data) {
+    if (data instanceof Blob) return this.receive_image(data);
+    let msg;
+    try { msg = JSON.parse(data); } catch { return this.handlers.error?.("unreadable message from the server"); }
+    switch (msg.type) {
+      case "hello": return this.handlers.hello?.(msg);
+      case "frame": this.pending_meta = msg; return;
+      case "tf_applied": return this.handlers.tf_applied?.(msg);
+      case "features_ready": return this.handlers.features_ready?.();
+      case "error": return this.handlers.error?.(msg.message);
+      default: return undefined;  // a newer server's message: the protocol only adds types
+    }
+  }
+
+  receive_image(blob) {
+    const meta = this.pending_meta;
+    this.pending_meta = null;
+    if (!meta) return this.handlers.error?.("image without a frame header");
+    // PNG or JPEG: the decoder sniffs the bytes. Decoded in order; colorSpaceConversion "none" keeps the PNG's 8-bit values exactly (no gamma/profile
+    // handling), so the canvas holds the bytes `raysift render -o x.png` writes.
+    const decoded = createImageBitmap(blob, { colorSpaceConversion: "none", premultiplyAlpha: "none" });
+    this.draw_chain = this.draw_chain.then(() => decoded).then(
+      (bitmap) => this.draw(bitmap, meta),
+      (err) => this.handlers.error?.(`could not decode a frame: ${err}`));
+  }
+
+  draw(bitmap, meta) {
+    const c = this.canvas;
+    if (c.width !== bitmap.width || c.height !== bitmap.height) {
+      c.width = bitmap.width;
+      c.height = bitmap.height;
+    }
+    c.getContext("2d").drawImage(bitmap, 0, 0);
+    bitmap.close();
+    const now = performance.now();
+    this.frames += 1;
+    this.last = meta;
+    this.record_latency(meta.camera_seq, now);
+    this.draw_times.push(now);
+    while (this.draw_times.length > 0 && now - this.draw_times[0] > RATE_WINDOW_MS) this.draw_times.shift();
+    if (this.drag && this.drag.active && meta.camera_seq >= this.drag.first_seq) {
+      this.drag.draws.push(now);
+      this.drag.frame_ms.push(meta.ms);
+      this.drag.budget_ms.push(meta.budget_ms);
+    }
+    this.handlers.frame?.(meta);
+  }
+
+  /// Every camera message up to camera_seq is now on screen: its latency is now - its send time.
+  record_latency(camera_seq, now) {
+    if (typeof camera_seq !== "number") return;
+    for (const [seq, sent] of this.sent_camera) {
+      if (seq > camera_seq) continue;
+      this.latencies_ms.push(now - sent);
+      this.sent_camera.delete(seq);
+    }
+    if (this.latencies_ms.length > LATENCY_KEEP) this.latencies_ms.splice(0, this.latencies_ms.length - LATENCY_KEEP);
+  }
+
+  /// A drag's frame rate counts the frames that reflect its camera messages, from the first to its end.
+  begin_drag(first_seq) { this.drag = { active: true, first_seq, draws: [], frame_ms: [], budget_ms: [] }; }
+  end_drag() { if (this.drag) this.drag.active = false; }
+
+  stats() {
+    const last = this.last;
+    const now = performance.now();
+    const recent = this.draw_times.filter((t) => now - t <= RATE_WINDOW_MS);  // none once the server idles
+    const n = recent.length;
+    const fps = n >= 2 ? ((n - 1) * 1000) / (recent[n - 1] - recent[0]) : null;
+    return {
+      frames: this.frames,
+      frame_ms: last ? last.ms : null,
+      budget_ms: last ? last.budget_ms : null,
+      fps,
+      rays_traced_pct: last && last.full_rays > 0 ? (100 * last.rays_traced) / last.full_rays : null,
+      converged: last ? !!last.converged : false,
+      show: last ? last.show : null,
+      seq: last ? last.seq : null,
+      camera_seq: last ? last.camera_seq : null,
+      latency_ms: {
+        last: this.latencies_ms.length ? this.latencies_ms[this.latencies_ms.length - 1] : null,
+        p50: percentile(this.latencies_ms, 50), p95: percentile(this.latencies_ms, 95),
+        max: this.latencies_ms.length ? Math.max(...this.latencies_ms) : null, count: this.latencies_ms.length,
+      },
+      drag: this.drag_stats(),
+    };
+  }
+
+  drag_stats() {
+    if (!this.drag) return null;
+    const t = this.drag.draws;
+    const intervals = t.slice(1).map((v, i) => v - t[i]);
+    return {
+      active: this.drag.active, frames: t.length,
+      fps: t.length >= 2 ? ((t.length - 1) * 1000) / (t[t.length - 1] - t[0]) : null,
+      interval_p50_ms: percentile(intervals, 50), interval_p95_ms: percentile(intervals, 95),
+      frame_ms_p50: percentile(this.drag.frame_ms, 50), budget_ms_p50: percentile(this.drag.budget_ms, 50),
+    };
+  }
+}
