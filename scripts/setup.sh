@@ -17,10 +17,10 @@ packages=(cmake g++ make pkg-config ccache zlib1g-dev
 case "$mode" in
   demo) build_all=OFF ;;
   test) build_all=ON  # + tests, the shell tools they call, the Python module with its test runner, Open MPI
-                      # (issue 19) and Chromium with a DevTools client for the browser test (issue 18)
+                      # (issue 19), Chromium with a DevTools client and Node for the page's tests (issue 18)
         packages+=(libgtest-dev libopenvdb-tools openimageio-tools
                    pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-openimageio
-                   libopenmpi-dev openmpi-bin chromium python3-websocket) ;;
+                   libopenmpi-dev openmpi-bin chromium python3-websocket python3-pil nodejs) ;;
   *) echo "usage: scripts/setup.sh demo|test" >&2; exit 2 ;;
 esac
 source scripts/install_missing.sh
