@@ -260,8 +260,7 @@ class Collapser {
   /// Every vertex's cheapest collapse (each interior edge is evaluated once, at the end it would remove).
   void fill_heap() {
     for (std::uint32_t v = 0; v < verts_.size(); ++v) {
-      ring_w_.clear();
-      for_each_neighbour(v, [&](std::uint32_t w) { ring_w_.push_back(w); });
+      neighbours(v, ring_w_);
       if (const std::uint64_t key = cheapest(v, ring_w_); key != kNoKey) heap_.append(key);
     }
     heap_.heapify();
@@ -299,8 +298,7 @@ class Collapser {
 
   /// Re-derives v's heap entry from all its edges.
   void refresh(std::uint32_t v) {
-    ring_w_.clear();
-    for_each_neighbour(v, [&](std::uint32_t w) { ring_w_.push_back(w); });
+    neighbours(v, ring_w_);
     set_key(v, cheapest(v, ring_w_));
   }
   void set_key(std::uint32_t v, std::uint64_t key) {
@@ -342,11 +340,11 @@ class Collapser {
   }
   std::uint64_t next_mark() { return ++mark_counter_; }  // 64 bits: never wraps
 
-  /// Sorted distinct neighbours of v.
+  /// Distinct neighbours of v, in no particular order: the heap's keys are distinct (they hold the vertex id), so
+  /// its top, and with it the result, does not depend on the order of the key updates.
   void neighbours(std::uint32_t v, std::vector<std::uint32_t>& out) {
     out.clear();
     for_each_neighbour(v, [&](std::uint32_t w) { out.push_back(w); });
-    std::sort(out.begin(), out.end());
   }
 
   /// Link condition for the interior edge (u, v): its two faces' opposite vertices are the only common
