@@ -62,10 +62,41 @@ struct EdgeCounts {
   }
 };
 
+/// The common case without sorting or union-find: v's triangles, none degenerate, form one consistently oriented
+/// closed fan, i.e. following each triangle's previous vertex to the triangle that has it as its next vertex
+/// (first match) walks all n triangles in one cycle. That makes the next vertices distinct and equal, as a set,
+/// to the previous ones, so each neighbour lies on exactly 2 triangles traversing the edge in opposite
+/// directions: v is Interior with n edges, what scan_vertex's general path finds. Returns false otherwise
+/// (counts untouched).
+bool scan_closed_fan(const TriMesh& mesh, const VertexFaces& vf, std::uint32_t v, EdgeCounts& counts) {
+  constexpr std::uint32_t kMaxFan = 32;
+  const std::uint32_t begin = vf.offsets[v], n = vf.offsets[v + 1] - begin;
+  if (n == 0 || n > kMaxFan) return false;
+  std::uint32_t next[kMaxFan], prev[kMaxFan];
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const Tri& t = mesh.triangles[vf.faces[begin + i]];
+    if (has_repeated_index(t)) return false;
+    const int k = t[0] == v ? 0 : (t[1] == v ? 1 : 2);
+    next[i] = t[(k + 1) % 3];
+    prev[i] = t[(k + 2) % 3];
+  }
+  std::uint32_t i = 0, steps = 0;
+  do {
+    std::uint32_t j = 0;
+    while (j < n && next[j] != prev[i]) ++j;
+    if (j == n) return false;
+    i = j;
+  } while (++steps < n && i != 0);
+  if (i != 0 || steps != n) return false;
+  for (std::uint32_t k = 0; k < n; ++k) counts.edges += next[k] > v;
+  return true;
+}
+
 /// Classifies vertex v from its own triangles only (so vertices are independent and run in parallel) and
 /// counts the edges (v, w) with w > v.
 VertexKind scan_vertex(const TriMesh& mesh, const VertexFaces& vf, std::uint32_t v, EdgeCounts& counts,
                        std::vector<std::pair<std::uint32_t, int>>& sides, std::vector<std::uint32_t>& fan_parent) {
+  if (scan_closed_fan(mesh, vf, v, counts)) return VertexKind::Interior;
   const std::uint32_t begin = vf.offsets[v], end = vf.offsets[v + 1];
   // Sides (w, direction): +1 if a triangle runs v -> w, -1 if it runs w -> v.
   sides.clear();

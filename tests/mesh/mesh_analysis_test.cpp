@@ -165,5 +165,33 @@ TEST(MeshAnalysis, VertexKindsFollowTheTopology) {
   EXPECT_EQ(fin_kinds[2], VertexKind::Boundary);
 }
 
+// The apexes have 40 triangles (more than the closed-fan fast path takes, so the general scan decides), the
+// equator vertices 4 (the fast path): both must give the same closed-manifold answer.
+TEST(MeshAnalysis, BipyramidWithHighValenceApexesIsWatertight) {
+  constexpr int n = 40;
+  TriMesh m;
+  for (int i = 0; i < n; ++i)
+    m.positions.push_back({float(std::cos(2 * kPi * i / n)), float(std::sin(2 * kPi * i / n)), 0.0f});
+  m.positions.push_back({0, 0, 1});
+  m.positions.push_back({0, 0, -1});
+  const auto top = std::uint32_t(n), bottom = std::uint32_t(n + 1);
+  for (std::uint32_t i = 0; i < std::uint32_t(n); ++i) {
+    const std::uint32_t j = (i + 1) % n;
+    m.triangles.push_back({i, j, top});
+    m.triangles.push_back({j, i, bottom});
+  }
+  const MeshAnalysis a = analyze_mesh(m);
+  EXPECT_TRUE(a.is_watertight());
+  EXPECT_EQ(a.edges, std::size_t(3 * n));
+  EXPECT_EQ(a.euler_characteristic, 2);
+  EXPECT_GT(a.signed_volume, 0);
+  for (const VertexKind k : classify_vertices(m)) EXPECT_EQ(k, VertexKind::Interior);
+
+  m.triangles[0] = {1, 0, top};  // one flipped triangle: orientation breaks at vertices 0, 1 and the apex
+  const MeshAnalysis flipped = analyze_mesh(m);
+  EXPECT_FALSE(flipped.is_watertight());
+  EXPECT_EQ(flipped.inconsistent_edges, 3u);
+}
+
 }  // namespace
 }  // namespace raysift::mesh
