@@ -15,7 +15,7 @@ targets=(transfer_function scene camera light nrrd raw ply obj off)
 cmake -S . -B build-fuzz -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=Debug \
   -DCMAKE_CXX_FLAGS_DEBUG="-g -O1 -fsanitize-ignorelist=$PWD/scripts/fuzz_ubsan_ignore.txt" \
   -DRAYSIFT_SANITIZE=fuzzer-no-link,address,undefined -DRAYSIFT_BUILD_FUZZ=ON \
-  -DRAYSIFT_BUILD_TESTS=OFF -DRAYSIFT_BUILD_BENCH=OFF -DRAYSIFT_PYTHON=OFF
+  -DRAYSIFT_BUILD_TESTS=OFF -DRAYSIFT_BUILD_BENCH=OFF -DRAYSIFT_PYTHON=OFF -DRAYSIFT_MPI=OFF
 cmake --build build-fuzz -j2 --target "${targets[@]/#/fuzz_}"
 
 # New inputs go to build-fuzz/corpus/<t> (the checked-in seeds stay read-only); two targets at a time on 2 cores.
