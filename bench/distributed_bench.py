@@ -11,7 +11,9 @@ said in the output). Prints per N: trace ms (wall, rank 0), speed-up and efficie
 max render_ms and composite_ms over ranks, bytes read per rank vs the file size.
 Part 2: compositing time vs image size: a 64³ ball at 4 image sizes, np 2 and 4; composite_ms (max over ranks) and
 a least-squares fit of the model T = L·(ceil(log2 N) + 1) + k·P·(1 − 1/N) (P pixels), printed for docs/distributed.md.
-Every number is printed next to `uptime`'s load: the machine is shared.
+Every number is printed next to `uptime`'s load: the machine is shared. On a saturated machine the wall-clock
+speed-up measures the scheduler's share, so the CPU seconds of all ranks (cpu_s, from the children's rusage, MPI
+start-up included) against the one-process run show the work the distribution adds.
 """
 import argparse
 import json
@@ -29,18 +31,24 @@ def load():
 
 
 def run(cmd, cwd):
+    """Runs cmd; returns the CPU seconds (user + system) of it and every process it waited for (the ranks)."""
+    before = os.times()
     r = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True)
+    after = os.times()
     if r.returncode != 0:
         sys.exit(f"failed ({r.returncode}): {' '.join(cmd)}\n{r.stderr}")
+    return (after.children_user - before.children_user) + (after.children_system - before.children_system)
 
 
 def render(exe, work, ranks, args, stats="s.json"):
     cmd = ([] if ranks == 0 else MPIRUN + ["-np", str(ranks)]) + [exe, "render"] + args + ["--stats", stats, "--quiet"]
     if ranks > 0:
         cmd += ["--distribute", "data"]
-    run(cmd, work)
+    cpu_s = run(cmd, work)
     with open(os.path.join(work, stats)) as f:
-        return json.load(f)
+        s = json.load(f)
+    s["cpu_s"] = cpu_s
+    return s
 
 
 def scaling(exe, work, side, ranks_list, threads):
@@ -55,9 +63,10 @@ def scaling(exe, work, side, ranks_list, threads):
           f"--threads {threads} per rank, 2 cores ==")
     ref = render(exe, work, 0, args)
     ref_ms = ref["times_ms"]["trace"]
-    print(f"one process (no MPI, reference): trace {ref_ms:.0f} ms, {ref['samples']} samples  (load {load():.1f})")
+    print(f"one process (no MPI, reference): trace {ref_ms:.0f} ms, {ref['samples']} samples, "
+          f"{ref['cpu_s']:.1f} CPU s  (load {load():.1f})")
     print("ranks  trace_ms  speedup  efficiency  max_render_ms  max_wait_ms  max_composite_ms  voxels_loaded_sum  max_bytes_read  "
-          "oversubscribed  load")
+          "oversubscribed  cpu_s  cpu_vs_ref  load")
     rows = []
     for n in ranks_list:
         s = render(exe, work, n, args)
@@ -69,7 +78,7 @@ def scaling(exe, work, side, ranks_list, threads):
         print(f"{n:5d}  {ms:8.0f}  {ref_ms / ms:7.2f}  {ref_ms / ms / n:10.2f}  "
               f"{max(r['render_ms'] for r in rk):13.0f}  {max(r['wait_ms'] for r in rk):11.0f}  "
               f"{max(r['composite_ms'] for r in rk):16.1f}  "
-              f"{loaded:>17d}  {max(r['bytes_read'] for r in rk):14d}  {over:>14s}  {load():4.1f}")
+              f"{loaded:>17d}  {max(r['bytes_read'] for r in rk):14d}  {over:>14s}  {s['cpu_s']:5.1f}  {s['cpu_s'] / ref['cpu_s']:10.2f}  {load():4.1f}")
         rows.append((n, ms, s["samples"]))
     return rows
 
