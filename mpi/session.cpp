@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <iostream>
 
 #include "core/errors.h"
 
@@ -58,6 +59,9 @@ Session::Session(int* argc, char*** argv) {
 #else
   (void)argc;
   (void)argv;
+  if (launched_by_mpi_launcher())  // every process would render the whole frame alone and write the same files
+    std::cerr << "raysift: warning: started by an MPI launcher, but this build has no MPI (RAYSIFT_MPI=OFF): each "
+                 "process runs as a separate one-rank job\n";
 #endif
 }
 
