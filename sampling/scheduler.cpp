@@ -26,6 +26,7 @@ void OvershootMargin::update(double frame_ms, double target_ms) {
 }
 
 void trace_all(Span<const std::uint32_t> pixels, const TraceBatch& trace, ImageRGBA& image) {
+  if (const auto* set = trace.target<SetTracer>()) return set->trace_set(pixels, image);
   const std::size_t groups = (pixels.size() + kRayGroup - 1) / kRayGroup;
   parallel_for_each(groups, [&](std::size_t g) {
     const std::size_t first = g * kRayGroup, count = std::min(kRayGroup, pixels.size() - first);
@@ -35,6 +36,8 @@ void trace_all(Span<const std::uint32_t> pixels, const TraceBatch& trace, ImageR
 
 std::size_t trace_until(Span<const std::uint32_t> queue, const TraceBatch& trace, ImageRGBA& image,
                         const ElapsedMs& elapsed_ms, double deadline_ms) {
+  if (const auto* set = trace.target<SetTracer>(); set && set->trace_prefix)
+    return set->trace_prefix(queue, image, elapsed_ms, deadline_ms);
   const std::size_t groups = (queue.size() + kRayGroup - 1) / kRayGroup;
   std::atomic<std::size_t> next{0};
   std::atomic<std::size_t> claimed{0};

@@ -18,7 +18,21 @@ using TraceBatch = std::function<void(Span<const std::uint32_t> pixels, Span<Rgb
 /// Rays handed to a worker at a time (RP paper section 7.6).
 inline constexpr std::size_t kRayGroup = 32;
 
-/// Traces every pixel of `pixels` in parallel groups of kRayGroup and stores the results in `image`.
+/// \brief A batch tracer that also takes a whole set at once. Stored in a TraceBatch, trace_all hands it each set in
+/// one call instead of one call per group of kRayGroup: the lock-step MPI ranks of mpi/image_parallel.h then make
+/// one exchange per refinement round, not one per 32 rays. trace_until hands it the queue when `trace_prefix` is
+/// set (which must keep trace_until's contract: a traced prefix, no launch after the deadline), else uses `batch`.
+struct SetTracer {
+  std::function<void(Span<const std::uint32_t> pixels, ImageRGBA& image)> trace_set;  ///< writes image.pixels[p]
+  TraceBatch batch;
+  std::function<std::size_t(Span<const std::uint32_t> queue, ImageRGBA& image,
+                            const std::function<double()>& elapsed_ms, double deadline_ms)>
+      trace_prefix;  ///< optional
+  void operator()(Span<const std::uint32_t> pixels, Span<Rgba> out) const { batch(pixels, out); }
+};
+
+/// Traces every pixel of `pixels` in parallel groups of kRayGroup and stores the results in `image` (a SetTracer
+/// gets the whole set).
 void trace_all(Span<const std::uint32_t> pixels, const TraceBatch& trace, ImageRGBA& image);
 
 /// Milliseconds since the frame began. The wall clock in production; tests inject a virtual clock that a

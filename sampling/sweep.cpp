@@ -90,4 +90,83 @@ EqualTimeComparison compare_at_equal_time(const volume::RayCaster& caster, const
   return out;
 }
 
+std::vector<SweepUnit> sweep_units(std::size_t points, const TradeOptions& trade, const SweepKnobs& knobs) {
+  const std::pair<SweepUnitKind, std::size_t> kinds[] = {
+      {SweepUnitKind::Full, 1},
+      {SweepUnitKind::Fraction, trade.ray_fractions.size()},
+      {SweepUnitKind::Budget, trade.budgets_ms.size()},
+      {SweepUnitKind::TimeFraction, trade.time_fractions.size()},
+      {SweepUnitKind::Step, knobs.steps.size()},
+      {SweepUnitKind::EarlyTermination, knobs.early_terminations.size()}};
+  std::vector<SweepUnit> units;
+  for (std::size_t point = 0; point < points; ++point)
+    for (const auto& [kind, count] : kinds)
+      for (std::size_t i = 0; i < count; ++i) units.push_back({point, kind, i});
+  return units;
+}
+
+namespace {
+
+/// Rows run_trade / run_render_knobs make per unit of a kind.
+std::size_t rows_per_unit(SweepUnitKind kind) {
+  switch (kind) {
+    case SweepUnitKind::Full: return 1;
+    case SweepUnitKind::Fraction: return 3;
+    case SweepUnitKind::Budget:
+    case SweepUnitKind::TimeFraction: return 2;
+    case SweepUnitKind::Step:
+    case SweepUnitKind::EarlyTermination: return 1;
+  }
+  return 0;
+}
+
+/// `all`'s entry for every unit of `kind`, in unit order.
+std::vector<double> picked(const std::vector<double>& all, SweepUnitKind kind, Span<const SweepUnit> units) {
+  std::vector<double> out;
+  for (const SweepUnit& u : units)
+    if (u.kind == kind) {
+      RAYSIFT_CHECK(u.index < all.size());
+      out.push_back(all[u.index]);
+    }
+  return out;
+}
+
+/// Index of the first row of each kind in the concatenated run_trade + run_render_knobs rows.
+std::size_t first_row(SweepUnitKind kind, Span<const SweepUnit> units) {
+  std::size_t row = 0;
+  for (const SweepUnit& u : units)
+    if (int(u.kind) < int(kind) && u.kind != SweepUnitKind::Full) row += rows_per_unit(u.kind);
+  return kind == SweepUnitKind::Full ? 0 : row + 1;  // the full row comes first
+}
+
+}  // namespace
+
+std::vector<std::vector<TradeRow>> run_sweep_units(const volume::Volume& volume, const volume::TransferFunction& tf,
+                                                   const volume::RayCaster& caster, const FeatureGeometry* geometry,
+                                                   const TradeOptions& trade, const SweepKnobs& knobs,
+                                                   Span<const SweepUnit> units) {
+  for (const SweepUnit& u : units) RAYSIFT_CHECK(u.point == units[0].point);
+  TradeOptions mine = trade;
+  mine.ray_fractions = picked(trade.ray_fractions, SweepUnitKind::Fraction, units);
+  mine.budgets_ms = picked(trade.budgets_ms, SweepUnitKind::Budget, units);
+  mine.time_fractions = picked(trade.time_fractions, SweepUnitKind::TimeFraction, units);
+  TradeResult result = run_trade(caster, geometry, mine);
+  const std::vector<TradeRow> knob_rows =
+      run_render_knobs(volume, tf, caster.camera().spec(), caster.options(),
+                       picked(knobs.steps, SweepUnitKind::Step, units),
+                       picked(knobs.early_terminations, SweepUnitKind::EarlyTermination, units), result, mine);
+  result.rows.insert(result.rows.end(), knob_rows.begin(), knob_rows.end());
+
+  // Units of one kind keep their relative order in `mine`, so each one's rows follow its predecessors'.
+  std::vector<std::vector<TradeRow>> out;
+  std::size_t seen[6] = {};
+  for (const SweepUnit& u : units) {
+    const std::size_t n = rows_per_unit(u.kind);
+    const std::size_t begin = first_row(u.kind, units) + n * seen[int(u.kind)]++;
+    RAYSIFT_CHECK(begin + n <= result.rows.size());
+    out.emplace_back(result.rows.begin() + std::ptrdiff_t(begin), result.rows.begin() + std::ptrdiff_t(begin + n));
+  }
+  return out;
+}
+
 }  // namespace raysift::sampling

@@ -10,9 +10,6 @@
 
 namespace raysift::sampling {
 
-namespace {
-
-/// True when volume::select_iso_values would find no surface (the TF hides every value the volume holds).
 bool transparent_over_data(const volume::Volume& volume, const volume::TransferFunction& tf) {
   const volume::GridInfo info = volume.info();
   return volume::max_tf_opacity(tf, info.value_min, info.value_max).opacity <= volume::IsoValueOptions{}.min_opacity;
@@ -22,8 +19,6 @@ FeatureGeometrySummary summarize(const FeatureGeometry& g) {
   return {g.mesh.triangles.size(), g.iso_values, g.hidden_iso_values, g.coarsening, g.from_cache, g.build_ms,
           g.level_ms,            g.probe_ms,    g.curvature_ms,        g.stages};
 }
-
-}  // namespace
 
 FeatureGeometry feature_geometry_for(const volume::Volume& volume, const volume::TransferFunction& tf,
                                      const isosurface::FeatureView& view, const FeatureGeometryOptions& options,

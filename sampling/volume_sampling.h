@@ -111,6 +111,11 @@ struct SampledRender {
   bool features_skipped = false;
 };
 
+/// True when volume::select_iso_values would find no surface (the TF hides every value the volume holds):
+/// render_sampled_volume then renders without feature lines.
+bool transparent_over_data(const volume::Volume& volume, const volume::TransferFunction& tf);
+FeatureGeometrySummary summarize(const FeatureGeometry& geometry);
+
 /// \throw InvalidInput for invalid options (see validate()), a progressive request outside the
 ///        prioritized mode, or feature geometry that cannot be built.
 SampledRender render_sampled_volume(const volume::Volume& volume, const volume::TransferFunction& tf,

@@ -2,6 +2,7 @@
 // caster) -> run the selected mode -> write. A new mode adds one entry to `modes()` (and its flags in
 // render_flags.cpp); everything before and after the dispatch is shared, so all modes composite and write alike.
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -18,6 +19,7 @@
 #include "core/timer.h"
 #include "core/memory_limit.h"
 #include "mpi/data_parallel.h"
+#include "mpi/image_parallel.h"
 #include "mpi/session.h"
 #include "volume/volume.h"
 
@@ -102,6 +104,34 @@ void write_frame(const std::string& out, ImageRGBA& image) {
   write_image(out, image);
 }
 
+/// --distribute image (mpi19b, mpi/image_parallel.h): every rank holds the whole grid and traces part of the frame.
+void render_image(const RenderCliOptions& o, const RenderInputs& in, const CommonOptions& common,
+                  mpi::RankStats stats, const Timer& total) {
+  const volume::RayCaster caster(in.volume, *in.tf, in.camera, in.options);
+  const double setup_ms = total.elapsed_ms();
+  const Timer trace;
+  ModeOutput out;
+  if (o.mode == "full") {
+    volume::RenderResult r = mpi::render_full_image_parallel(caster, stats);
+    out = ModeOutput{std::move(r.image), r.rays_traced, r.samples, Json::object()};
+  } else {
+    sampling::SampledRender r = mpi::render_sampled_image_parallel(in.volume, *in.tf, caster, in.sampled, stats);
+    Json extra = mpi::is_root() ? sampled_render_json(r, in.sampled.sampling.budget_ms) : Json::object();
+    out = ModeOutput{std::move(r.image), r.rays_traced, r.samples, std::move(extra)};
+  }
+  const double trace_ms = trace.elapsed_ms();
+  stats.bytes_sent += mpi::traffic().sent;
+  stats.bytes_received += mpi::traffic().received;
+  const Json ranks = mpi::gather_rank_stats(stats, "image");
+  if (!mpi::is_root()) return;
+  write_frame(o.out, out.image);
+  Json json = frame_stats(o, in, out.rays_traced, out.samples, caster.visible_block_count(), setup_ms, trace_ms,
+                          total.elapsed_ms());
+  json.merge_patch(out.extra_stats);
+  json.merge_patch(ranks);
+  write_stats_if_requested(common, json);
+}
+
 /// --distribute auto: data when the whole grid does not fit one rank's --max-memory, else image.
 std::string choose_distribution(const std::string& flag, std::uint64_t active_voxels, const MemoryLimit& limit) {
   if (flag != "auto") return flag;
@@ -131,6 +161,9 @@ void render_distributed(const RenderCliOptions& o, const PathCliOptions& p, cons
       VolumeRead whole;
       mpi::all_or_none([&] { whole.volume = volume::load_vdb(path, plan.grid, load, &whole.non_finite_voxels); });
       whole.info = whole.volume.info();
+      stats.active_voxels_loaded = whole.info.active_voxels;  // mpi19b: the whole grid
+      std::error_code no_size;
+      stats.bytes_read = std::filesystem::file_size(path, no_size);
       return whole;
     }
     mpi::BrickInput brick = mpi::load_brick(plan, path, load, limit);
@@ -138,7 +171,7 @@ void render_distributed(const RenderCliOptions& o, const PathCliOptions& p, cons
     return VolumeRead{std::move(brick.volume), brick.info, brick.non_finite_voxels};
   };
   const RenderInputs in = build_inputs(o, common, reader);
-  if (distribute == "image") throw UsageError("--distribute image is not available yet; use --distribute data");
+  if (distribute == "image") return render_image(o, in, common, stats, total);  // mpi19b: mpi/image_parallel.h
   const double setup_ms = total.elapsed_ms();
   const Timer trace;
   mpi::DataParallelFrame frame = mpi::render_data_parallel(plan, in.volume, *in.tf, in.camera, in.options);

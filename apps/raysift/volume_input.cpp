@@ -16,6 +16,18 @@ void add_volume_flags(CLI::App& sub, VolumeFlags& flags, const std::string& tf_h
   sub.add_flag("--tf-normalized", flags.tf_normalized, "TF x values are 0..1 over the data range");
 }
 
+volume::TfJsonOptions tf_json_options(const VolumeFlags& flags, const volume::GridInfo& info) {
+  volume::TfJsonOptions tf_options;
+  tf_options.normalized = flags.tf_normalized;
+  tf_options.data_min = info.value_min;
+  tf_options.data_max = info.value_max;
+  if (tf_options.data_min == tf_options.data_max) {  // a constant solid: normalise over it and the background
+    tf_options.data_min = std::min(info.value_min, info.background);
+    tf_options.data_max = std::max(info.value_max, info.background);
+  }
+  return tf_options;
+}
+
 VolumeInput load_volume_input(const VolumeFlags& flags, const std::string& scene_path, const CommonOptions& common,
                               const std::string& command, volume::EmptyGrid empty, const VolumeReader& reader) {
   VolumeInput in;
@@ -40,14 +52,7 @@ VolumeInput load_volume_input(const VolumeFlags& flags, const std::string& scene
     std::cerr << "raysift: warning: " << in.volume_path << ": " << in.non_finite_voxels << " NaN/Inf voxels loaded with --non-finite "
               << common.non_finite << "\n";
 
-  volume::TfJsonOptions tf_options;
-  tf_options.normalized = flags.tf_normalized;
-  tf_options.data_min = in.info.value_min;
-  tf_options.data_max = in.info.value_max;
-  if (tf_options.data_min == tf_options.data_max) {  // a constant solid: normalise over it and the background
-    tf_options.data_min = std::min(in.info.value_min, in.info.background);
-    tf_options.data_max = std::max(in.info.value_max, in.info.background);
-  }
+  const volume::TfJsonOptions tf_options = tf_json_options(flags, in.info);
   if (!flags.tf.empty()) {
     in.tf_source = flags.tf;
     in.tf = std::make_unique<volume::TransferFunction>(volume::load_transfer_function(flags.tf, tf_options));

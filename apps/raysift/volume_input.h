@@ -44,6 +44,9 @@ struct VolumeRead {
 using VolumeReader = std::function<VolumeRead(const std::string& path, const std::string& grid,
                                               const volume::LoadVdbOptions& options)>;
 
+/// How a TF file maps onto this grid: --tf-normalized over the data range (a constant grid: with its background).
+volume::TfJsonOptions tf_json_options(const VolumeFlags& flags, const volume::GridInfo& info);
+
 /// Loads the volume (flag, else the scene file's at `scene_path`, "" for none) and the TF (--tf, else the
 /// scene's; normalised ranges map to the grid's value range). NaN/Inf voxels follow --non-finite (a warning
 /// names their count unless --quiet). `empty` = Allow lets a grid without active voxels through (render
