@@ -1,5 +1,6 @@
 #!/usr/bin/python3
-"""Strong scaling of `raysift render --distribute data` (sort-last) and its compositing time vs image size.
+"""Strong scaling of `raysift render --distribute data` (sort-last) and `--distribute image` (tiles, mpi19b), and
+the data-parallel compositing time vs image size.
 
 Usage: bench/distributed_bench.py [--exe build/raysift] [--work /tmp/raysift_distributed_bench] [--ranks 1,2,4]
                                   [--threads 1] [--side 256]
@@ -40,10 +41,10 @@ def run(cmd, cwd):
     return (after.children_user - before.children_user) + (after.children_system - before.children_system)
 
 
-def render(exe, work, ranks, args, stats="s.json"):
+def render(exe, work, ranks, args, stats="s.json", distribute="data"):
     cmd = ([] if ranks == 0 else MPIRUN + ["-np", str(ranks)]) + [exe, "render"] + args + ["--stats", stats, "--quiet"]
     if ranks > 0:
-        cmd += ["--distribute", "data"]
+        cmd += ["--distribute", distribute]
     cpu_s = run(cmd, work)
     with open(os.path.join(work, stats)) as f:
         s = json.load(f)
@@ -65,17 +66,17 @@ def scaling(exe, work, side, ranks_list, threads):
     ref_ms = ref["times_ms"]["trace"]
     print(f"one process (no MPI, reference): trace {ref_ms:.0f} ms, {ref['samples']} samples, "
           f"{ref['cpu_s']:.1f} CPU s  (load {load():.1f})")
-    print("ranks  trace_ms  speedup  efficiency  max_render_ms  max_wait_ms  max_composite_ms  voxels_loaded_sum  max_bytes_read  "
+    print("mode   ranks  trace_ms  speedup  efficiency  max_render_ms  max_wait_ms  max_composite_ms  voxels_loaded_sum  max_bytes_read  "
           "oversubscribed  cpu_s  cpu_vs_ref  load")
     rows = []
-    for n in ranks_list:
-        s = render(exe, work, n, args)
+    for n, mode in [(n, m) for n in ranks_list for m in (("data",) if n == 1 else ("data", "image"))]:
+        s = render(exe, work, n, args, distribute=mode)
         ms = s["times_ms"]["trace"]
         # -np 1 is the one-process path (no "ranks" key): the whole grid, no compositing.
         rk = s.get("ranks", [{"render_ms": ms, "composite_ms": 0.0, "wait_ms": 0.0, "active_voxels_loaded": 0, "bytes_read": 0}])
         loaded = sum(r["active_voxels_loaded"] for r in rk)
         over = "yes" if n * threads > 2 else "no"
-        print(f"{n:5d}  {ms:8.0f}  {ref_ms / ms:7.2f}  {ref_ms / ms / n:10.2f}  "
+        print(f"{mode if n > 1 else '-':5s}  {n:5d}  {ms:8.0f}  {ref_ms / ms:7.2f}  {ref_ms / ms / n:10.2f}  "
               f"{max(r['render_ms'] for r in rk):13.0f}  {max(r['wait_ms'] for r in rk):11.0f}  "
               f"{max(r['composite_ms'] for r in rk):16.1f}  "
               f"{loaded:>17d}  {max(r['bytes_read'] for r in rk):14d}  {over:>14s}  {s['cpu_s']:5.1f}  {s['cpu_s'] / ref['cpu_s']:10.2f}  {load():4.1f}")
