@@ -99,6 +99,9 @@ DataParallelFrame render_data_parallel(const DataParallelPlan& plan, const volum
     }
     frame.render_ms = render.elapsed_ms();
   });
+  const Timer wait;
+  barrier();  // the slowest rank's lead is load imbalance, not compositing: keep it out of composite_ms
+  frame.wait_ms = wait.elapsed_ms();
   const Timer composite;
   const std::vector<int> order = visibility_order(plan.split, brick.world_to_index(camera.eye));
   const std::vector<float> image = composite_sort_last(std::move(rgba), order);

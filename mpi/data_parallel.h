@@ -46,6 +46,7 @@ struct DataParallelFrame {
   std::uint64_t samples = 0;    ///< summed over ranks
   std::uint64_t visible_blocks = 0;  ///< summed over ranks (blocks near brick planes count on both sides)
   double render_ms = 0, composite_ms = 0;  ///< this rank's
+  double wait_ms = 0;  ///< this rank's wait for the slowest rank between rendering and compositing
 };
 
 /// Collective: renders the segments of every ray inside this rank's brick (volume::SegmentClip, on the whole

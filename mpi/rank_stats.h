@@ -13,6 +13,7 @@ struct RankStats {
   std::uint64_t bytes_read = 0;            ///< bytes this rank read from the input file
   double render_ms = 0;                    ///< tracing this rank's rays or ray segments
   double composite_ms = 0;                 ///< compositing / assembling, including the final gather
+  double wait_ms = 0;                      ///< waiting for other ranks before compositing (load imbalance)
   std::uint64_t bytes_sent = 0, bytes_received = 0;  ///< MPI payload (mpi::traffic())
 };
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <iostream>
 
 #include "core/errors.h"
 
@@ -58,6 +59,9 @@ Session::Session(int* argc, char*** argv) {
 #else
   (void)argc;
   (void)argv;
+  if (launched_by_mpi_launcher())  // every process would render the whole frame alone and write the same files
+    std::cerr << "raysift: warning: started by an MPI launcher, but this build has no MPI (RAYSIFT_MPI=OFF): each "
+                 "process runs as a separate one-rank job\n";
 #endif
 }
 
@@ -164,12 +168,13 @@ void send(int peer, Span<const float> out) { exchange(peer, out, {}); }
 void receive(int peer, Span<float> in) { exchange(peer, {}, in); }
 
 namespace {
-double reduce(double value, [[maybe_unused]] bool is_sum, [[maybe_unused]] bool is_max) {
+enum class Reduction { Sum, Max, Min };
+double reduce(double value, [[maybe_unused]] Reduction op) {
 #if RAYSIFT_HAVE_MPI
   if (size() == 1) return value;
   double result = 0;
-  check(MPI_Allreduce(&value, &result, 1, MPI_DOUBLE, is_sum ? MPI_SUM : is_max ? MPI_MAX : MPI_MIN,
-                      MPI_COMM_WORLD), "MPI_Allreduce");
+  const MPI_Op mpi_op = op == Reduction::Sum ? MPI_SUM : op == Reduction::Max ? MPI_MAX : MPI_MIN;
+  check(MPI_Allreduce(&value, &result, 1, MPI_DOUBLE, mpi_op, MPI_COMM_WORLD), "MPI_Allreduce");
   return result;
 #else
   return value;
@@ -177,9 +182,9 @@ double reduce(double value, [[maybe_unused]] bool is_sum, [[maybe_unused]] bool 
 }
 }  // namespace
 
-double sum_all(double value) { return reduce(value, true, false); }
-double max_all(double value) { return reduce(value, false, true); }
-double min_all(double value) { return reduce(value, false, false); }
+double sum_all(double value) { return reduce(value, Reduction::Sum); }
+double max_all(double value) { return reduce(value, Reduction::Max); }
+double min_all(double value) { return reduce(value, Reduction::Min); }
 
 Traffic traffic() { return state().traffic; }
 

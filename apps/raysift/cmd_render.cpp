@@ -178,6 +178,7 @@ void render_distributed(const RenderCliOptions& o, const PathCliOptions& p, cons
   const double trace_ms = trace.elapsed_ms();
   stats.render_ms = frame.render_ms;
   stats.composite_ms = frame.composite_ms;
+  stats.wait_ms = frame.wait_ms;
   stats.bytes_sent = mpi::traffic().sent;
   stats.bytes_received = mpi::traffic().received;
   const Json ranks = mpi::gather_rank_stats(stats, distribute);

@@ -124,6 +124,20 @@ TEST_F(DataParallel, EachRankLoadsOnlyItsBrickPlusGhosts) {
   }
 }
 
+TEST_F(DataParallel, AutoChoosesDataOnlyWhenTheGridExceedsOneRanksMaxMemory) {
+  write_volume(dir_ + "/v.vdb", 64, random_sparse);  // 87 000 active voxels: a 390 KB grid bound, 1/3 + ghosts < 300 KB
+  const std::string args = "render v.vdb --tf tf.json --width 32 --height 24 -o out.exr --stats s.json";
+  test::CliRun r = ranks(3, dir_, args + " --max-memory 300K");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(read_json_file(dir_ + "/s.json")["distribute"], "data");
+  r = ranks(3, dir_, args);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(read_json_file(dir_ + "/s.json")["distribute"], "image");
+  r = ranks(3, dir_, args + " --max-memory 100K");  // even a brick is too large: one message, exit 1
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("brick of v.vdb"), std::string::npos) << r.err;
+}
+
 TEST_F(DataParallel, OneRankIsTheOneProcessRenderBitForBit) {
   write_volume(dir_ + "/v.vdb", 32, slab);
   const std::string args = "render v.vdb --tf tf.json --width 40 --height 30 --distribute data";
