@@ -13,7 +13,7 @@ packages=(cmake g++ make pkg-config ccache zlib1g-dev
   libopenmesh-dev libmeshoptimizer-dev libembree-dev
   libopenimageio-dev libopencv-core-dev
   libtbb-dev nlohmann-json3-dev libcli11-dev
-  libboost-dev)  # Boost.Beast: raysift serve's HTTP + WebSocket (docs/serve.md)
+  libboost-dev libjpeg-dev)  # raysift serve: Boost.Beast for HTTP + WebSocket, libjpeg for JPEG frames (docs/serve.md)
 case "$mode" in
   demo) build_all=OFF ;;
   test) build_all=ON  # + tests, the shell tools they call, the Python module with its test runner, Open MPI
