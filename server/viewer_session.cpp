@@ -95,6 +95,7 @@ Json ViewerSession::hello() const {
   return {{"type", "hello"},
           {"volume",
            {{"name", scene_.volume_name},
+            {"grid", scene_.grid_name},
             {"value_range", {h.min, h.max}},
             {"histogram", {{"range", {h.min, h.max}}, {"counts", h.counts}}}}},
           {"camera", camera_spec_to_json(view_.camera)},

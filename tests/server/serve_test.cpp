@@ -124,6 +124,8 @@ TEST(ServeProtocol, HelloDescribesTheVolumeTheDefaultCameraAndTheTf) {
   WsClient client(server.port());
   const Json& h = client.hello();
   EXPECT_EQ(h["type"], "hello");
+  EXPECT_EQ(h["volume"]["name"], "torus.vdb");
+  EXPECT_EQ(h["volume"]["grid"], "density");
   const volume::Volume v = volume::load_vdb(dir + "/torus.vdb");
   const volume::Histogram hist = volume::compute_histogram(v);
   EXPECT_EQ(h["volume"]["histogram"]["counts"], Json(hist.counts));
