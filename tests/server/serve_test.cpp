@@ -171,6 +171,15 @@ TEST(ServeProtocol, ConvergedPngFrameIsByteEqualToTheCliPng) {
   EXPECT_EQ(f.image, cli_png(dir, camera, "tf.json", "a"));
 }
 
+TEST(ServeProtocol, OneThreadConvergesToTheBytesOfTheCliOnAllCores) {
+  const std::string dir = make_torus_dir("serve_one_thread");
+  ServeProcess server(dir, "torus.vdb --tf tf.json --threads 1");
+  WsClient client(server.port());
+  const Json camera = camera_message(client.hello(), 1, {50, 45, -30});
+  client.send(camera);
+  EXPECT_EQ(client.read_converged(1).image, cli_png(dir, camera, "tf.json", "1"));  // the CLI with --threads 0
+}
+
 TEST(ServeProtocol, EveryModeConvergesToTheCliPng) {
   const std::string dir = make_torus_dir("serve_modes");
   ServeProcess server(dir, "torus.vdb --tf tf.json");
