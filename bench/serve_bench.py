@@ -166,6 +166,7 @@ def evaluate(renderer, sent, frames, drag_end, args, tmp):
 
 def main():
     args = parse_args()
+    os.environ["NO_PROXY"] = os.environ["no_proxy"] = "127.0.0.1"  # the server is local, whatever proxy is set
     scene = json.load(open(args.scene))
     base = os.path.dirname(os.path.abspath(args.scene))
     renderer = raysift.Renderer(raysift.Volume.load(os.path.join(base, scene["volume"])),
