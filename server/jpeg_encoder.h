@@ -1,6 +1,6 @@
 #pragma once
-/// \file JPEG frames for interaction: [choice] at 960x600 the CLI's PNG path costs ~40-150 ms a frame (zlib, measured
-/// in docs/serve.md), more than a 20 fps budget, while libjpeg-turbo takes a few ms. PNG stays the default and the
+/// \file JPEG frames for interaction: [choice] at 960x600 the CLI's PNG path costs ~10x a JPEG (155 vs 15 ms at load
+/// 17, docs/serve.md), more than a 20 fps budget. PNG stays the default and the
 /// one format that is byte-comparable with `raysift render`. Built when CMake finds libjpeg (libjpeg-dev).
 #include <cstdint>
 #include <vector>

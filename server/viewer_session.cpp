@@ -95,6 +95,7 @@ Json ViewerSession::hello() const {
   return {{"type", "hello"},
           {"volume",
            {{"name", scene_.volume_name},
+            {"grid", scene_.grid_name},
             {"value_range", {h.min, h.max}},
             {"histogram", {{"range", {h.min, h.max}}, {"counts", h.counts}}}}},
           {"camera", camera_spec_to_json(view_.camera)},
@@ -237,8 +238,9 @@ void ViewerSession::render_loop() {
       if (!is_new && superseded(rendered)) continue;  // a refinement of a view already left: not worth encoding
       const Timer send;
       if (!send_frame(frame, view, view.settings.mode == "full" ? 0.0 : budget_ms)) return;
-      overhead_ms = 0.5 * (overhead_ms + send.elapsed_ms());  // smoothed: one slow send does not halve a budget
-      scene_.stats->frame_sent(view.settings.mode, frame.ms, frame.ms + overhead_ms);
+      const double sent_ms = send.elapsed_ms();
+      overhead_ms = 0.5 * (overhead_ms + sent_ms);  // smoothed: one slow send does not halve a budget
+      scene_.stats->frame_sent(view.settings.mode, frame.ms, frame.ms + sent_ms);
     } catch (const Cancelled&) {
       return;
     } catch (const std::exception& e) {

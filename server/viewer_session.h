@@ -24,7 +24,8 @@ namespace raysift::server {
 /// What every viewer shares, built once by `raysift serve`.
 struct ServeScene {
   std::shared_ptr<const app::RenderSession> base;  ///< volume, startup TF, bricks, feature cache
-  std::string volume_name;
+  std::string volume_name;       ///< the file's name, e.g. "engine_ct.vdb"
+  std::string grid_name;         ///< the grid rendered, e.g. "density"
   volume::Histogram histogram;   ///< of the active voxels, for the page's TF editor and the iso-values
   CameraSpec camera;             ///< a new viewer's camera (the scene's, else the volume's fitted one)
   double target_fps = 10;        ///< a new viewer's rate

@@ -1,6 +1,7 @@
 // raysift serve: the volume in the browser (docs/serve.md). Loads the volume and TF once, then serves the embedded
 // page and one rendering session per WebSocket until Ctrl-C/SIGTERM; --stats is written on the way out.
 #include <csignal>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
@@ -34,7 +35,8 @@ void serve(const ServeCliOptions& o, const CommonOptions& common) {
   server::ServeStats stats;
   server::ServeScene scene;
   scene.base = std::make_shared<const RenderSession>(input.volume, *input.tf);
-  scene.volume_name = input.info.name;
+  scene.volume_name = std::filesystem::path(input.volume_path).filename().string();
+  scene.grid_name = input.info.name;
   scene.histogram = volume::compute_histogram(scene.base->volume());
   scene.camera = input.scene.camera ? *input.scene.camera : volume::fit_camera(input.volume, CameraSpec{}.width,
                                                                                  CameraSpec{}.height);

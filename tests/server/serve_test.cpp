@@ -124,6 +124,8 @@ TEST(ServeProtocol, HelloDescribesTheVolumeTheDefaultCameraAndTheTf) {
   WsClient client(server.port());
   const Json& h = client.hello();
   EXPECT_EQ(h["type"], "hello");
+  EXPECT_EQ(h["volume"]["name"], "torus.vdb");
+  EXPECT_EQ(h["volume"]["grid"], "density");
   const volume::Volume v = volume::load_vdb(dir + "/torus.vdb");
   const volume::Histogram hist = volume::compute_histogram(v);
   EXPECT_EQ(h["volume"]["histogram"]["counts"], Json(hist.counts));
@@ -167,6 +169,15 @@ TEST(ServeProtocol, ConvergedPngFrameIsByteEqualToTheCliPng) {
   const ServeFrame f = client.read_converged(1);
   EXPECT_EQ(f.header["rays_traced"], f.header["full_rays"]);
   EXPECT_EQ(f.image, cli_png(dir, camera, "tf.json", "a"));
+}
+
+TEST(ServeProtocol, OneThreadConvergesToTheBytesOfTheCliOnAllCores) {
+  const std::string dir = make_torus_dir("serve_one_thread");
+  ServeProcess server(dir, "torus.vdb --tf tf.json --threads 1");
+  WsClient client(server.port());
+  const Json camera = camera_message(client.hello(), 1, {50, 45, -30});
+  client.send(camera);
+  EXPECT_EQ(client.read_converged(1).image, cli_png(dir, camera, "tf.json", "1"));  // the CLI with --threads 0
 }
 
 TEST(ServeProtocol, EveryModeConvergesToTheCliPng) {
