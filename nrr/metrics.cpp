@@ -31,7 +31,7 @@ std::size_t count_if_index(std::size_t n, bool threaded, const std::function<boo
 
 /// The rule that produced reference image i (for visibility availability in metric 4).
 detail::ImageRule reference_rule(SamplingMode mode, Span<const DepthImage> reference, Span<const Camera> cameras,
-                                 std::size_t i) {
+                                 Span<const detail::PixelLookup> lookups, std::size_t i) {
   detail::ImageRule rule;
   rule.mode = mode;
   if (mode == SamplingMode::Peel) {
@@ -39,6 +39,7 @@ detail::ImageRule reference_rule(SamplingMode mode, Span<const DepthImage> refer
   } else {
     rule.previous = Span<const DepthImage>(reference.data(), i);
     rule.previous_cameras = Span<const Camera>(cameras.data(), i);
+    if (mode == SamplingMode::NrrPixel) rule.previous_lookups = Span<const detail::PixelLookup>(lookups.data(), i);
   }
   return rule;
 }
@@ -64,6 +65,7 @@ struct MetricsContext {
   Redundancy redundancy;
   std::vector<Camera> ref_cameras, conv_cameras;
   std::vector<detail::PixelProjector> ref_projectors, conv_projectors;
+  std::vector<detail::PixelLookup> ref_lookups;  ///< nrr-pixel references: for their sampling rule
 
   MetricsContext(const SampledScene& s, SamplingMode m, Span<const DepthImage> ref, Span<const DepthImage> conv,
                  const MetricsOptions& options)
@@ -73,6 +75,8 @@ struct MetricsContext {
     for (const DepthImage& im : conventional) conv_cameras.emplace_back(im.camera);
     for (const Camera& camera : ref_cameras) ref_projectors.emplace_back(camera);
     for (const Camera& camera : conv_cameras) conv_projectors.emplace_back(camera);
+    if (mode == SamplingMode::NrrPixel)
+      for (const DepthImage& im : reference) ref_lookups.emplace_back(im);
   }
 
   /// Whether `image` (taken by `camera`) captured the surface point x of triangle id, by the redundancy rule.
@@ -142,7 +146,8 @@ bool is_available(const MetricsContext& c, const Vec3f& x, mesh::TriangleId id) 
     const Vec3f eye(cam.eye());
     const mesh::RayF ray{eye, x - eye};
     mesh::Hit hit;
-    detail::trace(c.scene, reference_rule(c.mode, c.reference, Span<const Camera>(c.ref_cameras), i),
+    detail::trace(c.scene, reference_rule(c.mode, c.reference, Span<const Camera>(c.ref_cameras),
+                                                  Span<const detail::PixelLookup>(c.ref_lookups), i),
                   Span<const mesh::RayF>(&ray, 1), Span<mesh::Hit>(&hit, 1), false);
     if (hit.triangle_id == id) return true;
   }
