@@ -31,7 +31,7 @@ std::size_t count_if_index(std::size_t n, bool threaded, const std::function<boo
 
 /// The rule that produced reference image i (for visibility availability in metric 4).
 detail::ImageRule reference_rule(SamplingMode mode, Span<const DepthImage> reference, Span<const Camera> cameras,
-                                 std::size_t i) {
+                                 Span<const detail::PixelLookup> lookups, std::size_t i) {
   detail::ImageRule rule;
   rule.mode = mode;
   if (mode == SamplingMode::Peel) {
@@ -39,6 +39,7 @@ detail::ImageRule reference_rule(SamplingMode mode, Span<const DepthImage> refer
   } else {
     rule.previous = Span<const DepthImage>(reference.data(), i);
     rule.previous_cameras = Span<const Camera>(cameras.data(), i);
+    if (mode == SamplingMode::NrrPixel) rule.previous_lookups = Span<const detail::PixelLookup>(lookups.data(), i);
   }
   return rule;
 }
@@ -63,7 +64,9 @@ struct MetricsContext {
   bool threaded, by_pixel;
   Redundancy redundancy;
   std::vector<Camera> ref_cameras, conv_cameras;
-  std::vector<detail::PixelProjector> ref_projectors, conv_projectors;
+  /// Pixel redundancy against the reference and conventional images (also nrr-pixel's sampling rule):
+  /// the projector of pixel_captured with the blocked triangle lookup, so the same answers, faster.
+  std::vector<detail::PixelLookup> ref_lookups, conv_lookups;
 
   MetricsContext(const SampledScene& s, SamplingMode m, Span<const DepthImage> ref, Span<const DepthImage> conv,
                  const MetricsOptions& options)
@@ -71,14 +74,13 @@ struct MetricsContext {
         by_pixel(options.redundancy == Redundancy::Pixel), redundancy(options.redundancy) {
     for (const DepthImage& im : reference) ref_cameras.emplace_back(im.camera);
     for (const DepthImage& im : conventional) conv_cameras.emplace_back(im.camera);
-    for (const Camera& camera : ref_cameras) ref_projectors.emplace_back(camera);
-    for (const Camera& camera : conv_cameras) conv_projectors.emplace_back(camera);
+    for (const DepthImage& im : reference) ref_lookups.emplace_back(im);
+    for (const DepthImage& im : conventional) conv_lookups.emplace_back(im);
   }
 
   /// Whether `image` (taken by `camera`) captured the surface point x of triangle id, by the redundancy rule.
-  bool captured(const DepthImage& image, const Camera& camera, const detail::PixelProjector& projector, const Vec3f& x,
-                mesh::TriangleId id) const {
-    return by_pixel ? detail::pixel_captured(image, projector, x, id)
+  bool captured(const Camera& camera, const detail::PixelLookup& lookup, const Vec3f& x, mesh::TriangleId id) const {
+    return by_pixel ? lookup.holds(x, id)
                     : detail::visibility_redundant(scene, camera, redundancy, x, id);
   }
 };
@@ -94,7 +96,7 @@ void classify_image(const MetricsContext& c, std::size_t i, ImageMetrics& image_
   image_metrics.redundant = count_if_index(im.pixel_count(), c.threaded, [&](std::size_t p) {
     if (!im.has_sample(p)) return false;
     for (std::size_t j = 0; j < i; ++j)
-      if (c.captured(c.reference[j], c.ref_cameras[j], c.ref_projectors[j], im.position_ws(p), im.triangle_id[p]))
+      if (c.captured(c.ref_cameras[j], c.ref_lookups[j], im.position_ws(p), im.triangle_id[p]))
         return true;
     return false;
   });
@@ -109,7 +111,7 @@ void classify_image(const MetricsContext& c, std::size_t i, ImageMetrics& image_
       // directly (also right for hits at t = 0, which cannot be projected).
       const bool is_same_view = c.by_pixel && j == i && c.mode != SamplingMode::Peel;
       if (is_same_view ? c.conventional[j].triangle_id[p] == im.triangle_id[p]
-                       : c.captured(c.conventional[j], c.conv_cameras[j], c.conv_projectors[j], im.position_ws(p),
+                       : c.captured(c.conv_cameras[j], c.conv_lookups[j], im.position_ws(p),
                                     im.triangle_id[p]))
         return false;
     }
@@ -134,7 +136,7 @@ bool is_available(const MetricsContext& c, const Vec3f& x, mesh::TriangleId id) 
   }
   for (std::size_t i = 0; i < c.reference.size(); ++i) {
     if (c.by_pixel) {
-      if (detail::pixel_captured(c.reference[i], c.ref_projectors[i], x, id)) return true;
+      if (c.ref_lookups[i].holds(x, id)) return true;
       continue;
     }
     const Camera& cam = c.ref_cameras[i];
@@ -142,7 +144,8 @@ bool is_available(const MetricsContext& c, const Vec3f& x, mesh::TriangleId id) 
     const Vec3f eye(cam.eye());
     const mesh::RayF ray{eye, x - eye};
     mesh::Hit hit;
-    detail::trace(c.scene, reference_rule(c.mode, c.reference, Span<const Camera>(c.ref_cameras), i),
+    detail::trace(c.scene, reference_rule(c.mode, c.reference, Span<const Camera>(c.ref_cameras),
+                                                  Span<const detail::PixelLookup>(c.ref_lookups), i),
                   Span<const mesh::RayF>(&ray, 1), Span<mesh::Hit>(&hit, 1), false);
     if (hit.triangle_id == id) return true;
   }
@@ -163,7 +166,7 @@ void evaluate_intermediate_views(const MetricsContext& c, Span<const CameraSpec>
     conv.threaded = c.threaded;
     const DepthImage frame = std::move(render_depth_images(c.scene, Span<const CameraSpec>(&spec, 1), conv)[0]);
     const Camera frame_camera(frame.camera);
-    const detail::PixelProjector frame_projector(frame_camera);
+    const detail::PixelLookup frame_lookup(frame);
     const std::size_t samples = frame.sample_count();
     if (samples > 0) {
       const std::size_t available = count_if_index(frame.pixel_count(), c.threaded, [&](std::size_t p) {
@@ -178,8 +181,7 @@ void evaluate_intermediate_views(const MetricsContext& c, Span<const CameraSpec>
     count_if_index(disoccluded.size(), c.threaded, [&](std::size_t k) {
       const auto [i, p] = disoccluded[k];
       if (m.sample_classes[i][p] == SampleClass::Useful) return false;
-      if (!c.captured(frame, frame_camera, frame_projector, c.reference[i].position_ws(p),
-                      c.reference[i].triangle_id[p]))
+      if (!c.captured(frame_camera, frame_lookup, c.reference[i].position_ws(p), c.reference[i].triangle_id[p]))
         return false;
       m.sample_classes[i][p] = SampleClass::Useful;
       return true;

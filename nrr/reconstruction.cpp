@@ -36,9 +36,10 @@ void validate(const DepthImage& image, const char* what) {
 }
 
 void validate(const ReconstructionOptions& o) {
-  if (!(o.discontinuity_rel > 0.0) || !(o.corner_clamp_rel > 0.0) || !(o.normal_cos_min >= -1.0 && o.normal_cos_min <= 1.0))
-    throw InvalidInput("reconstruction options: discontinuity_rel and corner_clamp_rel must be > 0 and "
-                       "normal_cos_min in [-1, 1]");
+  if (!(o.discontinuity_rel > 0.0) || !(o.corner_clamp_rel > 0.0) || !(o.normal_cos_min >= -1.0 && o.normal_cos_min <= 1.0) ||
+      !(o.corner_clamp_footprints >= 0.0 && std::isfinite(o.corner_clamp_footprints)))
+    throw InvalidInput("reconstruction options: discontinuity_rel and corner_clamp_rel must be > 0, "
+                       "corner_clamp_footprints finite and >= 0, normal_cos_min in [-1, 1]");
 }
 
 // A sample in world space with its normal turned toward the camera.
@@ -165,6 +166,11 @@ Reconstruction reconstruct_hybrid(const DepthImage& image, const DepthImage& cor
   Reconstruction out;
   out.stats.samples = image.sample_count();
   std::vector<std::uint32_t> corner_vertex(std::size_t(w + 1) * std::size_t(h + 1), kNoVertex);
+  // Half-width of the depth interval of an estimated corner, per unit of the sample's depth.
+  const double pixel_side = 2.0 * std::tan(image.camera.fov_y_deg * M_PI / 360.0) / double(h);
+  const double clamp_rel = options.corner_clamp_footprints > 0.0
+                               ? std::min(options.corner_clamp_rel, options.corner_clamp_footprints * pixel_side)
+                               : options.corner_clamp_rel;
 
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
@@ -191,8 +197,7 @@ Reconstruction reconstruct_hybrid(const DepthImage& image, const DepthImage& cor
           }
         }
         // Missing or discontinuous corner: the corner ray meets the tangent plane, clamped in depth.
-        const double t = std::clamp(plane_depth(s, eye, dir), s.z * (1.0 - options.corner_clamp_rel),
-                                    s.z * (1.0 + options.corner_clamp_rel));
+        const double t = std::clamp(plane_depth(s, eye, dir), s.z * (1.0 - clamp_rel), s.z * (1.0 + clamp_rel));
         v[k] = std::uint32_t(out.mesh.positions.size());
         out.mesh.positions.push_back(Vec3f(eye + dir * t));
         ++out.stats.estimated_corners;

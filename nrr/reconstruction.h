@@ -4,10 +4,11 @@
 /// by a depth discontinuity; isolated samples vanish. Hybrid (NRR Alg. 4): every sample becomes a quad
 /// over its pixel whose corners come from the corner image H (rendered with pixel centres on the
 /// image's pixel corners) where H's sample is continuous with the sample, else from the corner ray's
-/// intersection with the sample's tangent plane. Key decision: valid corners are shared vertices
-/// (index of the corner in H), so a continuous surface is watertight without overdraw, and an
-/// estimated corner is clamped to within `corner_clamp_rel` of the sample's depth so that grazing
-/// tangent planes do not produce long slivers (ALGORITHMS.md §10).
+/// intersection with the sample's tangent plane. Key decisions: valid corners are shared vertices
+/// (index of the corner in H), so a continuous surface is watertight without overdraw; an estimated
+/// corner (no evidence that the surface reaches it) stays within one pixel footprint of the sample's
+/// depth: a sample is a surface element one sample spacing across, so grazing tangent planes do not
+/// stretch it into slivers many footprints deep (ALGORITHMS.md §10, docs/shadows.md).
 #include <cstdint>
 #include <vector>
 
@@ -25,8 +26,11 @@ struct ReconstructionOptions {
   double discontinuity_rel = tol::kDepthDiscontinuityRelative;
   /// ... and their normals (turned toward the camera) have a cosine above this.
   double normal_cos_min = 0.5;
-  /// Estimated hybrid corners stay within this fraction of the sample's view depth.
+  /// Estimated hybrid corners stay within this fraction of the sample's view depth ...
   double corner_clamp_rel = 0.01;
+  /// ... and within this many pixel footprints (the pixel's side at the sample's depth, i.e. the sample
+  /// spacing) of it; 0 = no footprint bound (only corner_clamp_rel, the rule before issue 14).
+  double corner_clamp_footprints = 1.0;
 };
 
 struct ReconstructionStats {

@@ -181,12 +181,15 @@ std::vector<DepthImage> render_depth_images(const SampledScene& scene, Span<cons
   cameras.reserve(views.size());
   for (const CameraSpec& v : views) cameras.emplace_back(v);
   images.reserve(views.size());
+  std::vector<detail::PixelLookup> lookups;
   for (std::size_t i = 0; i < views.size(); ++i) {
+    if (i > 0 && options.mode == SamplingMode::NrrPixel) lookups.emplace_back(images[i - 1]);
     images.emplace_back(cameras[i].spec());
     detail::ImageRule rule;
     rule.mode = options.mode;
     rule.previous = Span<const DepthImage>(images.data(), i);
     rule.previous_cameras = Span<const Camera>(cameras.data(), i);
+    rule.previous_lookups = Span<const detail::PixelLookup>(lookups);
     DepthImage& image = images.back();
     detail::for_each_tile(image, options.threaded, [&](Span<const mesh::RayF> rays, Span<const std::size_t> pixels) {
       std::vector<mesh::Hit> hits(rays.size());

@@ -73,6 +73,9 @@ void add_options(CLI::App& sub, ShadowsOptions& o) {
       ->capture_default_str();
   method->add_option("--corner-clamp", s.reconstruction.corner_clamp_rel,
                      "hybrid: estimated corners stay within this fraction of the sample depth")->capture_default_str();
+  method->add_option("--corner-clamp-footprints", s.reconstruction.corner_clamp_footprints,
+                     "hybrid: ... and within this many pixel footprints of it (0 = no footprint bound)")
+      ->capture_default_str();
   method->add_flag("--shading-normals", o.shading_normals,
                    "reconstruct with interpolated shading normals instead of face normals");
   auto* output = sub.add_option_group("Output");

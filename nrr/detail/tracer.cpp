@@ -66,9 +66,19 @@ PixelProjector::PixelProjector(const Camera& camera)
   down_ = camera.image_up() * (-half_h_ / tan_half_y);
 }
 
-bool pixel_captured(const DepthImage& image, const PixelProjector& projector, const Vec3f& x, mesh::TriangleId id) {
-  const std::ptrdiff_t pixel = projector.pixel(x);
-  return pixel >= 0 && image.triangle_id[std::size_t(pixel)] == id;
+PixelLookup::PixelLookup(const DepthImage& image) : projector_(Camera(image.camera)) {
+  const std::size_t side = std::size_t(1) << kShift;
+  blocks_x_ = (std::size_t(image.width) + side - 1) / side;
+  const std::size_t blocks_y = (std::size_t(image.height) + side - 1) / side;
+  ids_.assign(blocks_x_ * blocks_y * side * side, ~std::uint32_t(0));
+  for (std::size_t y = 0; y < std::size_t(image.height); ++y)
+    for (std::size_t x = 0; x < std::size_t(image.width); ++x) {
+      const mesh::TriangleId id = image.triangle_id[y * std::size_t(image.width) + x];
+      if (id == mesh::kNoTriangle) continue;
+      RAYSIFT_CHECK_OP(mesh::triangle_id_mesh(id), ==, 0u);
+      const std::size_t block = (y >> kShift) * blocks_x_ + (x >> kShift);
+      ids_[(block << (2 * kShift)) + ((y & kMask) << kShift) + (x & kMask)] = mesh::triangle_id_index(id);
+    }
 }
 
 bool in_frustum(const Camera& camera, const Vec3f& x) {
@@ -195,11 +205,11 @@ void trace(const SampledScene& scene, const ImageRule& rule, Span<const mesh::Ra
         scene.rays().intersect(rays, hits, options);
         return;
       }
-      const std::vector<PixelProjector> projectors(rule.previous_cameras.begin(), rule.previous_cameras.end());
+      RAYSIFT_CHECK_OP(rule.previous_lookups.size(), ==, rule.previous.size());
       const mesh::HitFilter keep_non_redundant = [&](const mesh::HitCandidate& c) {
         const Vec3f x = sample_position(rays[c.ray_index], c.t);
-        for (std::size_t j = 0; j < rule.previous.size(); ++j)
-          if (pixel_captured(rule.previous[j], projectors[j], x, c.triangle_id)) return false;
+        for (const PixelLookup& lookup : rule.previous_lookups)
+          if (lookup.holds(x, c.triangle_id)) return false;
         return true;
       };
       // The filter is pure, but QueryOptions::is_filter_pure stays off: redundancy rejects 15-50 % of

@@ -17,14 +17,21 @@ inline Vec3f sample_position(const mesh::RayF& ray, float t) { return sample_poi
 class PixelProjector {
  public:
   explicit PixelProjector(const Camera& camera);
-  /// Row-major pixel index of the pixel containing x, or -1 if x is behind the eye or outside.
-  std::ptrdiff_t pixel(const Vec3f& x) const {
+  /// Column and row of the pixel containing x; false if x is behind the eye or outside.
+  bool pixel_xy(const Vec3f& x, int& px, int& py) const {
     const Vec3d d = Vec3d(x) - eye_;
     const double depth = dot(d, forward_);
-    if (!(depth > 0.0)) return -1;
+    if (!(depth > 0.0)) return false;
     const double x_ss = dot(d, right_) / depth + half_w_, y_ss = dot(d, down_) / depth + half_h_;
-    if (!(x_ss >= 0.0 && x_ss < width_ && y_ss >= 0.0 && y_ss < height_)) return -1;
-    return std::ptrdiff_t(y_ss) * std::ptrdiff_t(width_) + std::ptrdiff_t(x_ss);
+    if (!(x_ss >= 0.0 && x_ss < width_ && y_ss >= 0.0 && y_ss < height_)) return false;
+    px = int(x_ss);
+    py = int(y_ss);
+    return true;
+  }
+  /// Row-major pixel index of the pixel containing x, or -1 if x is behind the eye or outside.
+  std::ptrdiff_t pixel(const Vec3f& x) const {
+    int px = 0, py = 0;
+    return pixel_xy(x, px, py) ? std::ptrdiff_t(py) * std::ptrdiff_t(width_) + px : -1;
   }
 
  private:
@@ -34,10 +41,38 @@ class PixelProjector {
 };
 
 /// Pixel (Alg. 3): `x` projects inside `image` onto a pixel holding triangle `id`.
-bool pixel_captured(const DepthImage& image, const PixelProjector& projector, const Vec3f& x, mesh::TriangleId id);
+/// Inline: the pixel-redundancy filter calls it for every front-facing candidate of later images.
+inline bool pixel_captured(const DepthImage& image, const PixelProjector& projector, const Vec3f& x,
+                           mesh::TriangleId id) {
+  const std::ptrdiff_t pixel = projector.pixel(x);
+  return pixel >= 0 && image.triangle_id[std::size_t(pixel)] == id;
+}
 inline bool pixel_captured(const DepthImage& image, const Camera& camera, const Vec3f& x, mesh::TriangleId id) {
   return pixel_captured(image, PixelProjector(camera), x, id);
 }
+
+/// pixel_captured for the candidates of the pixel-redundancy filter, which reprojects every front-facing
+/// candidate of a later image into every earlier one: the same projector and so the same answers, but
+/// the image's triangle indices in 8x8-pixel blocks of 32 bits (4 cache lines a block instead of 8 rows
+/// of 8-byte ids), because the lookup's cache misses, not the arithmetic, dominated its cost.
+class PixelLookup {
+ public:
+  /// \pre every sample of `image` is of mesh 0 (SampledScene holds one mesh).
+  explicit PixelLookup(const DepthImage& image);
+  bool holds(const Vec3f& x, mesh::TriangleId id) const {
+    int px = 0, py = 0;
+    if (!projector_.pixel_xy(x, px, py)) return false;
+    const std::size_t block = std::size_t(py >> kShift) * blocks_x_ + std::size_t(px >> kShift);
+    const std::size_t at = (block << (2 * kShift)) + (std::size_t(py & kMask) << kShift) + std::size_t(px & kMask);
+    return ids_[at] == std::uint32_t(id) && mesh::triangle_id_mesh(id) == 0;
+  }
+
+ private:
+  static constexpr int kShift = 3, kMask = (1 << kShift) - 1;
+  PixelProjector projector_;
+  std::size_t blocks_x_ = 0;
+  std::vector<std::uint32_t> ids_;  ///< triangle index, ~0 where empty
+};
 
 /// x projects inside the camera's image (in front of the eye, within [0, w) x [0, h)).
 bool in_frustum(const Camera& camera, const Vec3f& x);
@@ -64,6 +99,7 @@ struct ImageRule {
   SamplingMode mode = SamplingMode::Conventional;
   Span<const DepthImage> previous;  ///< nrr-pixel: the images before this one
   Span<const Camera> previous_cameras;  ///< the NRR modes: their cameras
+  Span<const PixelLookup> previous_lookups;  ///< nrr-pixel: one per previous image
   int layer = 0;                    ///< peel: 0 = nearest front face
 };
 

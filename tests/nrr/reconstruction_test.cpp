@@ -166,12 +166,44 @@ TEST(HybridReconstruction, ClampsGrazingCorners) {
   EXPECT_NEAR(max_move, 0.01 * z, 1e-5 * z);  // at the clamp (float vertices: 1e-5 relative)
 }
 
+TEST(HybridReconstruction, BoundsEstimatedCornersByThePixelFootprint) {
+  // The isolated grazing sample of ClampsGrazingCorners under a 1 degree field of view: one pixel
+  // footprint (the pixel's side at depth z) is 0.145 % of z, tighter than corner_clamp_rel's 1 %, and
+  // the tangent plane (slope 9 along x) would move the corners 4.5 footprints.
+  auto grazing = [](double x, double) { return kDepth * std::pow(1.05, x); };
+  auto one = [](double x, double y) { return std::abs(x - 5.5) < 0.3 && std::abs(y - 4.5) < 0.3; };
+  CameraSpec spec = test_camera();
+  spec.fov_y_deg = 1.0;
+  DepthImage image = plane_image(spec, 0.5, one, grazing);
+  const std::size_t p = 4 * 16 + 5;
+  image.normal_ws[p] = Vec3f(normalize(Vec3d{0.9, 0, 0.1}));
+  const DepthImage corners = plane_image(corner_camera(spec), 0.0, one, grazing);
+  const double z = image.depth[p], footprint = 2.0 * std::tan(0.5 * M_PI / 180.0) / spec.height * z;
+  const auto max_move = [&](const ReconstructionOptions& o) {
+    double m = 0;
+    for (const Vec3f& v : reconstruct_hybrid(image, corners, o).mesh.positions)
+      m = std::max(m, std::abs(-double(v.z) - z));
+    return m;
+  };
+  EXPECT_NEAR(max_move({}), footprint, 1e-5 * z);  // at one footprint (float vertices: 1e-5 relative)
+  ReconstructionOptions two;
+  two.corner_clamp_footprints = 2.0;
+  EXPECT_NEAR(max_move(two), 2.0 * footprint, 1e-5 * z);
+  ReconstructionOptions unbounded;
+  unbounded.corner_clamp_footprints = 0.0;  // only the 1 % depth fraction, which the plane stays inside
+  EXPECT_GT(max_move(unbounded), 4.0 * footprint);
+}
+
 TEST(Reconstruction, BadInputThrows) {
   const CameraSpec spec = test_camera();
   DepthImage image = plane_image(spec, 0.5, rectangle, flat);
   DepthImage wrong_h = plane_image(spec, 0.0, rectangle, flat);  // H must be (W+1) x (H+1)
   EXPECT_THROW(reconstruct_hybrid(image, wrong_h), InvalidInput);
   ReconstructionOptions bad;
+  ReconstructionOptions negative_footprints;
+  negative_footprints.corner_clamp_footprints = -1.0;
+  EXPECT_THROW(reconstruct_hybrid(image, plane_image(corner_camera(spec), 0.0, rectangle, flat), negative_footprints),
+               InvalidInput);
   bad.discontinuity_rel = 0;
   EXPECT_THROW(reconstruct_conventional(image, bad), InvalidInput);
   image.depth[3 * 16 + 5] = std::nanf("");
