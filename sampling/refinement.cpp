@@ -302,10 +302,15 @@ class Refiner {
   // Appends (x, y) of `level` to `ready` unless it is known, taken or waits for a corner, decided on the small
   // state_ mask alone (most children asked about wait for a corner), and prefetches the cells its priority
   // reads: these are scattered, and a chunk's priorities are computed after all its children are listed.
+  // The record is written in place: built on the stack, its narrow stores were reloaded as one wide copy into
+  // the vector, a store-forwarding stall per child (perf: a fifth of the offers' time).
   void list_ready(int x, int y, int level, std::vector<Ready>& ready) const {
     if (state_(x, y) != 0) return;
     const int lattice_mask = 2 * parent_offset(level, pattern_.base_spacing) - 1;
-    Ready r{std::uint32_t(y) * std::uint32_t(imp_.width) + std::uint32_t(x), level, 0, {}};
+    Ready& r = ready.emplace_back();
+    r.pixel = std::uint32_t(y) * std::uint32_t(imp_.width) + std::uint32_t(x);
+    r.level = level;
+    r.known = 0;
     for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
       const int px = x + o[0], py = y + o[1];
       if (px < 0 || py < 0 || px >= imp_.width || py >= imp_.height) continue;
@@ -313,15 +318,17 @@ class Refiner {
       // The squares' centres beside an edge midpoint only add contrast: requiring them would let a flat
       // neighbour cell block the refinement of an edge cell.
       if (!(state_(px, py) & kKnown)) {
-        if ((px & lattice_mask) == 0 && (py & lattice_mask) == 0) return;  // offered again when it is traced
+        if ((px & lattice_mask) == 0 && (py & lattice_mask) == 0) {
+          ready.pop_back();  // offered again when it is traced
+          return;
+        }
         continue;
       }
-      r.parents[r.known++] = std::uint32_t(py) * std::uint32_t(imp_.width) + std::uint32_t(px);
+      r.parents[std::size_t(r.known++)] = std::uint32_t(py) * std::uint32_t(imp_.width) + std::uint32_t(px);
     }
-    for (int i = 0; i < r.known; ++i) __builtin_prefetch(&cells_.pixels[r.parents[i]]);
+    for (int i = 0; i < r.known; ++i) __builtin_prefetch(&cells_.pixels[r.parents[std::size_t(i)]]);
     __builtin_prefetch(&cells_.pixels[r.pixel]);
     __builtin_prefetch(&imp_.pixels[r.pixel]);
-    ready.push_back(r);
   }
 
   // Appends `r` with its priority unless it would not be pushed.
