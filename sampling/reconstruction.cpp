@@ -115,7 +115,8 @@ kInline Rgba cubic_1d(const ImageRGBA& image, int x, int y, int dx, int dy) {
 kInline Rgba cubic_centre(const ImageRGBA& image, int x0, int y0, int s) {
   V4 sum = splat(0);
   for (int j = 0; j < 4; ++j)
-    for (int i = 0; i < 4; ++i) sum = sum + splat(kCubicMid[i] * kCubicMid[j]) * load(image(x0 + (i - 1) * s, y0 + (j - 1) * s));
+    for (int i = 0; i < 4; ++i)
+      sum = sum + splat(kCubicMid[i] * kCubicMid[j]) * load(image(x0 + (i - 1) * s, y0 + (j - 1) * s));
   const V4 a = load(image(x0, y0)), b = load(image(x0 + s, y0 + s)), c = load(image(x0 + s, y0)),
            d = load(image(x0, y0 + s));
   return clamp_between(sum, vmin(vmin(vmin(a, b), c), d), vmax(vmax(vmax(a, b), c), d));
