@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "core/parallel.h"
@@ -20,22 +21,28 @@ struct Corner {
   float weight;
 };
 
-kInline Rgba weighted_sum(const ImageRGBA& image, const std::array<Corner, 4>& corners) {
-  Rgba out;
-  for (const Corner& c : corners) {
-    const Rgba& p = image(c.x, c.y);
-    out.r += c.weight * p.r;
-    out.g += c.weight * p.g;
-    out.b += c.weight * p.b;
-    out.a += c.weight * p.a;
-  }
+// One pixel's four channels in one SSE register (GCC/Clang vector extension): the same operations in the same
+// order per channel as the scalar code, so the results are bit-identical, in a quarter of the instructions.
+typedef float V4 __attribute__((vector_size(16)));
+
+kInline V4 load(const Rgba& p) {
+  V4 v;
+  std::memcpy(&v, &p, sizeof v);
+  return v;
+}
+kInline Rgba to_rgba(V4 v) { return {v[0], v[1], v[2], v[3]}; }
+kInline V4 splat(float f) { return V4{f, f, f, f}; }
+// std::min(a, b) and std::max(a, b) per lane, ties and NaN included ((b < a) ? b : a and (a < b) ? b : a).
+kInline V4 vmin(V4 a, V4 b) { return b < a ? b : a; }
+kInline V4 vmax(V4 a, V4 b) { return a < b ? b : a; }
+
+kInline V4 weighted_sum(const ImageRGBA& image, const std::array<Corner, 4>& corners) {
+  V4 out = splat(0);
+  for (const Corner& c : corners) out = out + splat(c.weight) * load(image(c.x, c.y));
   return out;
 }
 
-kInline Rgba clamp01(Rgba p) {
-  auto c = [](float v) { return std::min(1.0f, std::max(0.0f, v)); };
-  return {c(p.r), c(p.g), c(p.b), c(p.a)};
-}
+kInline Rgba clamp01(V4 p) { return to_rgba(vmin(splat(1), vmax(splat(0), p))); }
 
 // Square cell of a lattice with spacing h along one axis: start x0 and coordinate u in cell units.
 // Cells are shifted left so they end inside the image (u > 1 then extrapolates); a lattice with a single
@@ -84,52 +91,35 @@ bool cell_corners(int x, int y, int state, int spacing, int w, int h, std::array
 
 
 kInline Rgba mean_of(const ImageRGBA& image, const std::array<Corner, 4>& corners, int n) {
-  Rgba sum;
-  for (int i = 0; i < n; ++i) {
-    const Rgba& p = image(corners[i].x, corners[i].y);
-    sum = {sum.r + p.r, sum.g + p.g, sum.b + p.b, sum.a + p.a};
-  }
-  const float inv = 1.0f / float(n);
-  return clamp01({sum.r * inv, sum.g * inv, sum.b * inv, sum.a * inv});
+  V4 sum = splat(0);
+  for (int i = 0; i < n; ++i) sum = sum + load(image(corners[i].x, corners[i].y));
+  return clamp01(sum * splat(1.0f / float(n)));
 }
 
 // The 4-point interpolatory midpoint rule (Dubuc / Deslauriers-Dubuc): exact for cubics, so for affine
 // images too; clamped to the two inner taps' range per channel, so an edge does not ring.
 constexpr std::array<float, 4> kCubicMid{-1.0f / 16, 9.0f / 16, 9.0f / 16, -1.0f / 16};
 
-kInline Rgba clamp_between(Rgba v, const Rgba& a, const Rgba& b) {
-  auto c = [](float x, float p, float q) { return std::min(std::max(p, q), std::max(std::min(p, q), x)); };
-  return {c(v.r, a.r, b.r), c(v.g, a.g, b.g), c(v.b, a.b, b.b), c(v.a, a.a, b.a)};
-}
+kInline Rgba clamp_between(V4 v, V4 a, V4 b) { return to_rgba(vmin(vmax(a, b), vmax(vmin(a, b), v))); }
 
 // Cubic value at (x, y) from the taps x + (2i-3) dx.. along one axis (dx, dy) = the half step; the caller has
 // checked that all four are available.
 kInline Rgba cubic_1d(const ImageRGBA& image, int x, int y, int dx, int dy) {
   std::array<Corner, 4> taps;
   for (int i = 0; i < 4; ++i) taps[i] = {x + (2 * i - 3) * dx, y + (2 * i - 3) * dy, kCubicMid[i]};
-  return clamp_between(weighted_sum(image, taps), image(taps[1].x, taps[1].y), image(taps[2].x, taps[2].y));
+  return clamp_between(weighted_sum(image, taps), load(image(taps[1].x, taps[1].y)), load(image(taps[2].x, taps[2].y)));
 }
 
 // Cubic centre of the square (x0, y0)-(x0+s, y0+s): the tensor rule over the 4x4 lattice around it, whose
-// taps the caller has checked.
+// taps the caller has checked. The corner range folds left to right, as std::min/max of a list do.
 kInline Rgba cubic_centre(const ImageRGBA& image, int x0, int y0, int s) {
-  Rgba sum;
+  V4 sum = splat(0);
   for (int j = 0; j < 4; ++j)
-    for (int i = 0; i < 4; ++i) {
-      const int x = x0 + (i - 1) * s, y = y0 + (j - 1) * s;
-      const float wgt = kCubicMid[i] * kCubicMid[j];
-      const Rgba& p = image(x, y);
-      sum = {sum.r + wgt * p.r, sum.g + wgt * p.g, sum.b + wgt * p.b, sum.a + wgt * p.a};
-    }
-  const Rgba& a = image(x0, y0);
-  const Rgba& b = image(x0 + s, y0 + s);
-  const Rgba& c = image(x0 + s, y0);
-  const Rgba& d = image(x0, y0 + s);
-  const Rgba lo{std::min({a.r, b.r, c.r, d.r}), std::min({a.g, b.g, c.g, d.g}), std::min({a.b, b.b, c.b, d.b}),
-                std::min({a.a, b.a, c.a, d.a})};
-  const Rgba hi{std::max({a.r, b.r, c.r, d.r}), std::max({a.g, b.g, c.g, d.g}), std::max({a.b, b.b, c.b, d.b}),
-                std::max({a.a, b.a, c.a, d.a})};
-  return clamp_between(sum, lo, hi);
+    for (int i = 0; i < 4; ++i)
+      sum = sum + splat(kCubicMid[i] * kCubicMid[j]) * load(image(x0 + (i - 1) * s, y0 + (j - 1) * s));
+  const V4 a = load(image(x0, y0)), b = load(image(x0 + s, y0 + s)), c = load(image(x0 + s, y0)),
+           d = load(image(x0, y0 + s));
+  return clamp_between(sum, vmin(vmin(vmin(a, b), c), d), vmax(vmax(vmax(a, b), c), d));
 }
 
 // Availability of the s-lattice columns (x = i s) on the rows y0 + k s, k in [k0, k1), ANDed per column (a row
@@ -255,7 +245,7 @@ void reconstruct_fractal(ImageRGBA& image, const ImageMask& known, const Fractal
       }
       if (!done) {
         const float inv = partial_weight > 0 ? 1.0f / partial_weight : 0.0f;
-        image(x, y) = clamp01({partial.r * inv, partial.g * inv, partial.b * inv, partial.a * inv});
+        image(x, y) = clamp01(V4{partial.r * inv, partial.g * inv, partial.b * inv, partial.a * inv});
       }
     }
   });
