@@ -174,7 +174,7 @@ DataSampledFrame render_sampled_data_parallel(const DataParallelPlan& plan, cons
     if (request.sampling.mode == sampling::SamplingMode::Prioritized && !request.features.classes.is_empty() &&
         request.sampling.budget_ms <= 0)
       throw UsageError("--distribute data computes no feature lines (each rank holds one brick): pass "
-                         "--features none for the control importance, or use --distribute image");
+                       "--features none for the control importance, or use --distribute image");
     sampling::validate(request.sampling);
     caster = std::make_unique<volume::RayCaster>(brick, tf, camera, segment_options(plan, options));
   });
