@@ -1,10 +1,17 @@
 #include "mpi/data_parallel.h"
 
 #include <limits>
+#include <memory>
 
+#include "core/errors.h"
 #include "core/timer.h"
 #include "mpi/composite.h"
+#include "mpi/image_parallel.h"
 #include "mpi/session.h"
+
+#if RAYSIFT_HAVE_MPI
+#include <mpi.h>
+#endif
 
 namespace raysift::mpi {
 
@@ -77,13 +84,24 @@ BrickInput load_brick(const DataParallelPlan& plan, const std::string& path, con
   return in;
 }
 
+namespace {
+
+/// This rank's segment options: its brick's clip on the whole grid's lattice, no background (segments stay
+/// premultiplied until the whole ray is composited).
+volume::RenderOptions segment_options(const DataParallelPlan& plan, volume::RenderOptions options) {
+  const Brick& mine = plan.split.bricks[std::size_t(rank())];
+  options.background = {0, 0, 0};
+  options.clip = {true, mine.own_lo, mine.own_hi, plan.index_min, plan.index_max};
+  return options;
+}
+
+}  // namespace
+
 DataParallelFrame render_data_parallel(const DataParallelPlan& plan, const volume::Volume& brick,
                                        const volume::TransferFunction& tf, const CameraSpec& camera,
                                        volume::RenderOptions options) {
-  const Brick& mine = plan.split.bricks[std::size_t(rank())];
   const Vec3f background = options.background;
-  options.background = {0, 0, 0};  // segments stay premultiplied until the whole ray is composited
-  options.clip = {true, mine.own_lo, mine.own_hi, plan.index_min, plan.index_max};
+  options = segment_options(plan, options);
   DataParallelFrame frame;
   std::vector<float> rgba;
   all_or_none([&] {  // an invalid option or camera fails on every rank before any rank starts compositing
@@ -114,6 +132,58 @@ DataParallelFrame render_data_parallel(const DataParallelPlan& plan, const volum
           {image[4 * i], image[4 * i + 1], image[4 * i + 2], image[4 * i + 3]}, background);
   }
   frame.composite_ms = composite.elapsed_ms();
+  return frame;
+}
+
+namespace {
+
+/// The control importance on every rank: -1 where the pixel is background for every brick, else 0. Each brick
+/// caster's mask is exact for its segment (a background pixel's segment is transparent black), so a pixel all
+/// masks call background traces to transparent black: skipping it keeps a ray fraction of 1 exact.
+ImageF shared_background_importance(const volume::RayCaster& caster, RankStats& stats) {
+  Image<std::uint8_t> background = caster.background_mask();
+#if RAYSIFT_HAVE_MPI
+  if (size() > 1) {
+    const Timer timer;
+    MPI_Allreduce(MPI_IN_PLACE, background.pixels.data(), int(background.pixels.size()), MPI_UINT8_T, MPI_BAND,
+                  MPI_COMM_WORLD);
+    stats.composite_ms += timer.elapsed_ms();
+    stats.bytes_sent += background.pixels.size();  // about one mask each way per rank
+    stats.bytes_received += background.pixels.size();
+  }
+#else
+  (void)stats;
+#endif
+  ImageF importance(caster.width(), caster.height(), 0.0f);
+  for (std::size_t i = 0; i < importance.pixels.size(); ++i) importance.pixels[i] = background.pixels[i] ? -1.0f : 0.0f;
+  return importance;
+}
+
+}  // namespace
+
+DataSampledFrame render_sampled_data_parallel(const DataParallelPlan& plan, const volume::Volume& brick,
+                                              const volume::TransferFunction& tf, const CameraSpec& camera,
+                                              volume::RenderOptions options,
+                                              const sampling::SampledRenderRequest& request, RankStats& stats) {
+  const Vec3f background = options.background;
+  std::unique_ptr<volume::RayCaster> caster;
+  all_or_none([&] {  // the same checks on every rank, before the first collective
+    if (request.progressive_frames != 0)
+      throw UsageError("--distribute data renders single frames; --progressive is not distributed");
+    // Lines need one mesh of the whole volume; a rank holds one brick. Budget frames use the control anyway.
+    if (request.sampling.mode == sampling::SamplingMode::Prioritized && !request.features.classes.is_empty() &&
+        request.sampling.budget_ms <= 0)
+      throw UsageError("--distribute data computes no feature lines (each rank holds one brick): pass "
+                       "--features none for the control importance, or use --distribute image");
+    sampling::validate(request.sampling);
+    caster = std::make_unique<volume::RayCaster>(brick, tf, camera, segment_options(plan, options));
+  });
+  const Timer total;
+  const ImageF importance = shared_background_importance(*caster, stats);
+  const std::vector<int> order = visibility_order(plan.split, brick.world_to_index(camera.eye));
+  DataSampledFrame frame;
+  frame.render = render_sampled_lockstep(importance, total, *caster, request.sampling, background, order, stats);
+  frame.visible_blocks = std::uint64_t(sum_all(double(caster->visible_block_count())));
   return frame;
 }
 

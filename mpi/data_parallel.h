@@ -13,6 +13,7 @@
 #include "core/memory_limit.h"
 #include "mpi/kd_split.h"
 #include "mpi/rank_stats.h"
+#include "sampling/volume_sampling.h"
 #include "volume/raycaster.h"
 #include "volume/transfer_function.h"
 #include "volume/vdb_brick_io.h"
@@ -55,5 +56,20 @@ struct DataParallelFrame {
 DataParallelFrame render_data_parallel(const DataParallelPlan& plan, const volume::Volume& brick,
                                        const volume::TransferFunction& tf, const CameraSpec& camera,
                                        volume::RenderOptions options);
+
+/// \brief Collective: a prioritized or subsample frame in the image mode's lock step (mpi/image_parallel.h), each
+/// set of rays traced as segments on every rank and composited in the k-d visibility order on every rank. The
+/// importance is the control (background -1, else 0), computed identically on every rank: a pixel is
+/// background iff every rank's brick caster says so (an all-reduce of the masks). Rank 0 gets the image.
+/// \throw (as RankFailure on every rank) UsageError for feature lines (prioritized with --features and a ray
+/// fraction) or progressive frames.
+struct DataSampledFrame {
+  sampling::SampledRender render;    ///< rank 0: image, counts and stage times; elsewhere no image
+  std::uint64_t visible_blocks = 0;  ///< summed over ranks, as DataParallelFrame's
+};
+DataSampledFrame render_sampled_data_parallel(const DataParallelPlan& plan, const volume::Volume& brick,
+                                              const volume::TransferFunction& tf, const CameraSpec& camera,
+                                              volume::RenderOptions options,
+                                              const sampling::SampledRenderRequest& request, RankStats& stats);
 
 }  // namespace raysift::mpi

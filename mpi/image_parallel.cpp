@@ -9,6 +9,7 @@
 #include "core/errors.h"
 #include "core/parallel.h"
 #include "core/timer.h"
+#include "mpi/composite.h"
 #include "mpi/session.h"
 #include "mpi/tile_queue.h"
 
@@ -181,10 +182,13 @@ namespace {
 /// The lock-step tracer: each rank traces the positions ray_owner gives it and one all-gather gives every rank all
 /// of the set (a whole refinement round through trace_set, a budget group through trace_group). Called only from
 /// render_sampled in a one-thread arena, so every rank makes the same collectives in the same order and the
-/// buffers are reused; the rank's own rays are traced on all its threads.
+/// buffers are reused; the rank's own rays are traced on all its threads. With a `segment_order` (data mode)
+/// every rank traces every ray of the set through its brick instead, and each ray is its ranks' segments
+/// composited front to back in that order.
 class LockstepTracer {
  public:
-  LockstepTracer(const volume::RayCaster& caster, RankStats& stats) : caster_(caster), stats_(stats) {}
+  LockstepTracer(const volume::RayCaster& caster, RankStats& stats, const std::vector<int>& segment_order)
+      : caster_(caster), stats_(stats), order_(segment_order) {}
 
   void trace_group(Span<const std::uint32_t> pixels, Span<Rgba> out) {
     exchange(pixels, [&](std::size_t k, const Rgba& c) { out[k] = c; });
@@ -197,7 +201,7 @@ class LockstepTracer {
   /// broadcast) is before the deadline: a prefix, two collectives per chunk instead of per group.
   std::size_t trace_prefix(Span<const std::uint32_t> queue, ImageRGBA& image, const std::function<double()>& elapsed_ms,
                            double deadline_ms) {
-    const std::size_t chunk = kChunkGroups * sampling::kRayGroup * std::size_t(size());
+    const std::size_t chunk = kChunkGroups * sampling::kRayGroup * std::size_t(segments() ? 1 : size());
     std::size_t done = 0;
     while (done < queue.size() && elapsed_ms() < deadline_ms) {
       const std::size_t n = std::min(chunk, queue.size() - done);
@@ -215,11 +219,20 @@ class LockstepTracer {
     std::uint32_t count, first, last;  ///< the set every rank must be tracing
   };
 
+  bool segments() const { return !order_.empty(); }
+  /// Rays of a set of `count` that rank `r` traces.
+  std::size_t rays_of(int r, std::size_t count) const {
+    if (segments()) return count;
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < count; ++i) k += ray_owner(i, count, size()) == r;
+    return k;
+  }
+
   void trace_mine(Span<const std::uint32_t> pixels) {
     const int me = rank(), n = size();
     mine_.clear();
     for (std::size_t k = 0; k < pixels.size(); ++k)
-      if (ray_owner(k, pixels.size(), n) == me) mine_.push_back(pixels[k]);
+      if (segments() || ray_owner(k, pixels.size(), n) == me) mine_.push_back(pixels[k]);
     rays_.resize(mine_.size());
     const Timer timer;
     std::atomic<std::uint64_t> taken{0};
@@ -246,8 +259,8 @@ class LockstepTracer {
     std::memcpy(send_.data(), &header, sizeof header);
     for (std::size_t j = 0; j < rays_.size(); ++j)
       std::memcpy(send_.data() + sizeof header + j * sizeof(Rgba), &rays_[j].color, sizeof(Rgba));
-    counts_.assign(std::size_t(n), int(sizeof header));
-    for (std::size_t k = 0; k < pixels.size(); ++k) counts_[std::size_t(ray_owner(k, pixels.size(), n))] += int(sizeof(Rgba));
+    counts_.resize(std::size_t(n));
+    for (int r = 0; r < n; ++r) counts_[std::size_t(r)] = int(sizeof header + rays_of(r, pixels.size()) * sizeof(Rgba));
     displs_.assign(std::size_t(n), 0);
     for (int r = 1; r < n; ++r) displs_[std::size_t(r)] = displs_[std::size_t(r - 1)] + counts_[std::size_t(r - 1)];
     recv_.resize(std::size_t(displs_.back() + counts_.back()));
@@ -263,17 +276,37 @@ class LockstepTracer {
       // A mismatch means the ranks' sampling runs diverged: a bug, never input.
       RAYSIFT_CHECK(theirs.count == header.count && theirs.first == header.first && theirs.last == header.last);
     }
+    if (segments()) {
+      for (std::size_t k = 0; k < pixels.size(); ++k) store(k, composited(k));
+      return;
+    }
     cursor_.assign(std::size_t(n), 0);
     for (std::size_t k = 0; k < pixels.size(); ++k) {
       const std::size_t r = std::size_t(ray_owner(k, pixels.size(), n));
-      Rgba c;
-      std::memcpy(&c, recv_.data() + displs_[r] + sizeof(Header) + cursor_[r]++ * sizeof(Rgba), sizeof c);
-      store(k, c);
+      store(k, received(r, cursor_[r]++));
     }
+  }
+
+  Rgba received(std::size_t r, std::size_t j) const {
+    Rgba c;
+    std::memcpy(&c, recv_.data() + displs_[r] + sizeof(Header) + j * sizeof(Rgba), sizeof c);
+    return c;
+  }
+
+  /// Ray k of the set: every rank's segment of it, front to back ("over" as the full frame's binary swap).
+  Rgba composited(std::size_t k) const {
+    float ray[4] = {0, 0, 0, 0}, segment[4];
+    for (int r : order_) {
+      const Rgba c = received(std::size_t(r), k);
+      segment[0] = c.r, segment[1] = c.g, segment[2] = c.b, segment[3] = c.a;
+      composite_over(ray, segment, 1);
+    }
+    return {ray[0], ray[1], ray[2], ray[3]};
   }
 
   const volume::RayCaster& caster_;
   RankStats& stats_;
+  const std::vector<int>& order_;  ///< data mode: ranks front to back; empty = image mode
   tbb::task_arena all_threads_;  ///< the rank's own rays use every thread, unlike the lock-step control
   std::vector<std::uint32_t> mine_;
   std::vector<volume::RaySample> rays_;
@@ -355,15 +388,31 @@ sampling::SampledRender render_sampled_image_parallel(const volume::Volume& volu
 #if RAYSIFT_HAVE_MPI
   sampling::validate(request.sampling);
   const Timer total;
+  sampling::SampledRender lines;
+  const ImageF importance = shared_importance(volume, tf, caster, request, lines, stats);
+  sampling::SampledRender out =
+      render_sampled_lockstep(importance, total, caster, request.sampling, caster.options().background, {}, stats);
+  out.features = std::move(lines.features);
+  out.features_skipped = lines.features_skipped;
+  return out;
+#else
+  RAYSIFT_CHECK(false);  // size() > 1 needs MPI
+  return {};
+#endif
+}
+
+sampling::SampledRender render_sampled_lockstep(const ImageF& importance, const Timer& total,
+                                                const volume::RayCaster& caster,
+                                                const sampling::SamplingOptions& sampling, const Vec3f& background,
+                                                const std::vector<int>& segment_order, RankStats& stats) {
+#if RAYSIFT_HAVE_MPI
   sampling::SampledRender out;
-  out.mode = request.sampling.mode;
-  const ImageF importance = shared_importance(volume, tf, caster, request, out, stats);
+  out.mode = sampling.mode;
   double importance_ms = total.elapsed_ms();
   broadcast_value(importance_ms);
   const Timer frame_clock;
-  const sampling::SamplingOptions options =
-      lockstep_options(request.sampling, caster.width(), caster.height(), frame_clock);
-  LockstepTracer tracer(caster, stats);
+  const sampling::SamplingOptions options = lockstep_options(sampling, caster.width(), caster.height(), frame_clock);
+  LockstepTracer tracer(caster, stats, segment_order);
   sampling::SampledFrame frame;
   tbb::task_arena one_thread(1);
   one_thread.execute([&] {
@@ -377,7 +426,7 @@ sampling::SampledRender render_sampled_image_parallel(const volume::Volume& volu
   });
   out.samples = sum_on_root(tracer.samples);
   if (!is_root()) return out;
-  out.image = sampling::composite_frame(frame.image, caster.options().background);
+  out.image = sampling::composite_frame(frame.image, background);
   out.rays_traced = frame.rays_traced;
   out.full_rays = frame.full_rays;
   out.level0_rays = frame.level0_rays;
@@ -389,7 +438,8 @@ sampling::SampledRender render_sampled_image_parallel(const volume::Volume& volu
   out.budget_too_small = out.any_budget_too_small = frame.budget_too_small;
   return out;
 #else
-  RAYSIFT_CHECK(false);  // size() > 1 needs MPI
+  (void)importance, (void)total, (void)caster, (void)sampling, (void)background, (void)segment_order, (void)stats;
+  RAYSIFT_CHECK(false);  // needs MPI
   return {};
 #endif
 }

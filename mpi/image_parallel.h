@@ -11,6 +11,9 @@
 ///   Budget mode reads rank 0's clock, broadcast at every reading: all ranks stop at the same group, and the
 ///   traced rays are a prefix of the single process's order. The ray choice is bit-identical to one process
 ///   for a ray fraction.
+#include <vector>
+
+#include "core/timer.h"
 #include "mpi/rank_stats.h"
 #include "sampling/volume_sampling.h"
 #include "volume/raycaster.h"
@@ -28,5 +31,15 @@ volume::RenderResult render_full_image_parallel(const volume::RayCaster& caster,
 sampling::SampledRender render_sampled_image_parallel(const volume::Volume& volume, const volume::TransferFunction& tf,
                                                       const volume::RayCaster& caster,
                                                       const sampling::SampledRenderRequest& request, RankStats& stats);
+
+/// \brief Collective: the lock step above with a given `importance` (every rank's equal) and `total` started
+/// before it was computed. Rank 0 gets the frame composited over `background`. `segment_order` empty: image
+/// mode (rays dealt over the ranks). Otherwise --distribute data (mpi/data_parallel.h): `caster` renders this
+/// rank's brick segments, every rank traces every ray of each set and the segments are composited in that
+/// order (ranks front to back), so every rank sees the same colours.
+sampling::SampledRender render_sampled_lockstep(const ImageF& importance, const Timer& total,
+                                                const volume::RayCaster& caster,
+                                                const sampling::SamplingOptions& sampling, const Vec3f& background,
+                                                const std::vector<int>& segment_order, RankStats& stats);
 
 }  // namespace raysift::mpi

@@ -104,6 +104,22 @@ void write_frame(const std::string& out, ImageRGBA& image) {
   write_image(out, image);
 }
 
+/// Rank 0 writes a distributed frame and its stats with every rank's (the lock step's own MPI bytes are in
+/// `stats` already; the session's are added).
+void write_distributed(const RenderCliOptions& o, const RenderInputs& in, const CommonOptions& common,
+                       const std::string& distribute, mpi::RankStats stats, ModeOutput out,
+                       std::uint64_t visible_blocks, double setup_ms, double trace_ms, const Timer& total) {
+  stats.bytes_sent += mpi::traffic().sent;
+  stats.bytes_received += mpi::traffic().received;
+  const Json ranks = mpi::gather_rank_stats(stats, distribute);
+  if (!mpi::is_root()) return;
+  write_frame(o.out, out.image);
+  Json json = frame_stats(o, in, out.rays_traced, out.samples, visible_blocks, setup_ms, trace_ms, total.elapsed_ms());
+  json.merge_patch(out.extra_stats);
+  json.merge_patch(ranks);
+  write_stats_if_requested(common, json);
+}
+
 /// --distribute image (mpi19b, mpi/image_parallel.h): every rank holds the whole grid and traces part of the frame.
 void render_image(const RenderCliOptions& o, const RenderInputs& in, const CommonOptions& common,
                   mpi::RankStats stats, const Timer& total) {
@@ -119,17 +135,22 @@ void render_image(const RenderCliOptions& o, const RenderInputs& in, const Commo
     Json extra = mpi::is_root() ? sampled_render_json(r, in.sampled.sampling.budget_ms) : Json::object();
     out = ModeOutput{std::move(r.image), r.rays_traced, r.samples, std::move(extra)};
   }
-  const double trace_ms = trace.elapsed_ms();
-  stats.bytes_sent += mpi::traffic().sent;
-  stats.bytes_received += mpi::traffic().received;
-  const Json ranks = mpi::gather_rank_stats(stats, "image");
-  if (!mpi::is_root()) return;
-  write_frame(o.out, out.image);
-  Json json = frame_stats(o, in, out.rays_traced, out.samples, caster.visible_block_count(), setup_ms, trace_ms,
-                          total.elapsed_ms());
-  json.merge_patch(out.extra_stats);
-  json.merge_patch(ranks);
-  write_stats_if_requested(common, json);
+  write_distributed(o, in, common, "image", stats, std::move(out), caster.visible_block_count(), setup_ms, trace.elapsed_ms(),
+                    total);
+}
+
+/// --distribute data with --mode prioritized|subsample (mpi/data_parallel.h): the image mode's lock step on
+/// brick segments.
+void render_data_sampled(const RenderCliOptions& o, const RenderInputs& in, const mpi::DataParallelPlan& plan,
+                         const CommonOptions& common, mpi::RankStats stats, const Timer& total) {
+  const double setup_ms = total.elapsed_ms();
+  const Timer trace;
+  mpi::DataSampledFrame frame =
+      mpi::render_sampled_data_parallel(plan, in.volume, *in.tf, in.camera, in.options, in.sampled, stats);
+  sampling::SampledRender& r = frame.render;
+  Json extra = mpi::is_root() ? sampled_render_json(r, in.sampled.sampling.budget_ms) : Json::object();
+  ModeOutput out{std::move(r.image), r.rays_traced, r.samples, std::move(extra)};
+  write_distributed(o, in, common, "data", stats, std::move(out), frame.visible_blocks, setup_ms, trace.elapsed_ms(), total);
 }
 
 /// --distribute auto: data when the whole grid does not fit one rank's --max-memory, else image.
@@ -155,8 +176,6 @@ void render_distributed(const RenderCliOptions& o, const PathCliOptions& p, cons
   const VolumeReader reader = [&](const std::string& path, const std::string& grid, const volume::LoadVdbOptions& load) {
     plan = mpi::plan_bricks(path, grid);
     distribute = choose_distribution(distribute, plan.active_voxels, limit);
-    if (distribute == "data" && o.mode != "full")
-      throw UsageError("--distribute data renders --mode full only; use --distribute image for --mode " + o.mode);
     if (distribute == "image") {  // every rank holds the whole grid
       VolumeRead whole;
       mpi::all_or_none([&] { whole.volume = volume::load_vdb(path, plan.grid, load, &whole.non_finite_voxels); });
@@ -172,6 +191,7 @@ void render_distributed(const RenderCliOptions& o, const PathCliOptions& p, cons
   };
   const RenderInputs in = build_inputs(o, common, reader);
   if (distribute == "image") return render_image(o, in, common, stats, total);  // mpi19b: mpi/image_parallel.h
+  if (o.mode != "full") return render_data_sampled(o, in, plan, common, stats, total);
   const double setup_ms = total.elapsed_ms();
   const Timer trace;
   mpi::DataParallelFrame frame = mpi::render_data_parallel(plan, in.volume, *in.tf, in.camera, in.options);
