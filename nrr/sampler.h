@@ -5,6 +5,7 @@
 /// back-facing candidate is rejected inside traversal and the ray continues, so each pixel costs one
 /// traversal (ALGORITHMS.md §10). Visibility redundancy and peeling collect candidates during that
 /// traversal and test them afterwards, because no ray query may start inside a filter.
+#include <array>
 #include <string>
 #include <vector>
 
@@ -61,6 +62,11 @@ class SampledScene {
   double diagonal() const { return rays_.bounds().diagonal(); }
   /// Mean triangle edge length, world units (for the triangle-size / pixel-size ratio in reports).
   double mean_edge_length() const { return mean_edge_; }
+  /// The three corners of triangle `id`, CCW seen from its front.
+  std::array<Vec3d, 3> corners(mesh::TriangleId id) const {
+    const auto& t = mesh_.triangles[mesh::triangle_id_index(id)];
+    return {Vec3d(mesh_.positions[t[0]]), Vec3d(mesh_.positions[t[1]]), Vec3d(mesh_.positions[t[2]])};
+  }
 
  private:
   mesh::RayScene rays_;

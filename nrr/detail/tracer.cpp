@@ -112,6 +112,25 @@ bool visibility_redundant(const SampledScene& scene, const Camera& camera, Redun
 
 namespace {
 
+/// Margins of surely_crosses, far above the float error of Embree's own test (~1e-7 relative).
+constexpr double kSureMargin = 1e-4;
+
+/// An exact shortcut of Alg. 2's occlusion ray from `eye` to x: true when the segment (as Embree gets it,
+/// t in [0, 1 - kSegmentEndRelative]) crosses the interior of front face `occluder` by margins so wide
+/// that Embree's watertight test reports that hit too; false means "trace the ray".
+bool surely_crosses(const SampledScene& scene, mesh::TriangleId occluder, const Vec3f& eye, const Vec3f& x) {
+  const Vec3d o(eye), d(Vec3f(x - eye));
+  const Vec3d n = scene.face_normal(occluder);
+  if (!(dot(n, d) < -kSureMargin * length(d))) return false;  // surely front-facing (and not degenerate)
+  const auto p = scene.corners(occluder);
+  const Vec3d e1 = p[1] - p[0], e2 = p[2] - p[0], q = cross(d, e2);
+  const double det = dot(e1, q);
+  const Vec3d w = o - p[0], r = cross(w, e1);
+  const double b1 = dot(w, q) / det, b2 = dot(d, r) / det, t = dot(e2, r) / det;
+  return b1 > kSureMargin && b2 > kSureMargin && 1.0 - b1 - b2 > kSureMargin && t > kSureMargin &&
+         t < 1.0 - tol::kSegmentEndRelative - kSureMargin;
+}
+
 /// Marks redundant[k] = 1 for the faces found[k] (hit along rays[active[k]]) that are redundant.
 using RedundancyMarker = std::function<void(Span<const mesh::Hit> found, Span<const std::size_t> active,
                                             std::vector<std::uint8_t>& redundant)>;
@@ -170,14 +189,21 @@ RedundancyMarker visibility_marker(const SampledScene& scene, const ImageRule& r
     std::vector<mesh::RayF> shadow;
     std::vector<std::size_t> owner;
     std::vector<std::uint8_t> blocked;
-    for (const Camera& cam : rule.previous_cameras) {
+    RAYSIFT_CHECK_OP(rule.previous.size(), ==, rule.previous_cameras.size());
+    for (std::size_t c = 0; c < rule.previous_cameras.size(); ++c) {
+      const Camera& cam = rule.previous_cameras[c];
       const Vec3f eye(cam.eye());
+      const PixelProjector projector(cam);
       shadow.clear();
       owner.clear();
       for (std::size_t k = 0; k < active.size(); ++k) {
         if (!found[k].is_hit() || redundant[k]) continue;
         const Vec3f x = sample_position(rays[active[k]], found[k].t);
         if (!may_be_visibility_redundant(scene, cam, redundancy, x, found[k].triangle_id)) continue;
+        // The earlier image's front face at x's pixel is what usually hides x from that eye.
+        const std::ptrdiff_t pixel = projector.pixel(x);
+        const mesh::TriangleId shown = pixel < 0 ? mesh::kNoTriangle : rule.previous[c].triangle_id[std::size_t(pixel)];
+        if (shown != mesh::kNoTriangle && shown != found[k].triangle_id && surely_crosses(scene, shown, eye, x)) continue;
         shadow.push_back({eye, x - eye, 0.0f, 1.0f - float(tol::kSegmentEndRelative)});
         owner.push_back(k);
       }
