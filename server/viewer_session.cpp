@@ -216,6 +216,7 @@ void ViewerSession::render_loop() {
   FrameRenderer renderer;
   std::uint64_t rendered = 0;
   double overhead_ms = 0;  // encode + send of the last frame, taken off the next budget
+  double overrun_ms = 0;   // by how much budgeted renders exceed their budget, also taken off: the latency target
   auto next_start = std::chrono::steady_clock::now();
   View view;
   while (next_view(rendered, renderer.converged(), view)) {
@@ -229,7 +230,7 @@ void ViewerSession::render_loop() {
       next_start = std::chrono::steady_clock::now() + std::chrono::microseconds(std::int64_t(period_ms * 1000));
     }
     rendered = view.version;
-    const double budget_ms = std::max(period_ms - overhead_ms, 0.1 * period_ms);
+    const double budget_ms = std::max(period_ms - overhead_ms - overrun_ms, 0.1 * period_ms);
     FrameRequest request;
     request.render = view.render.get();
     request.camera = view.camera;
@@ -247,7 +248,8 @@ void ViewerSession::render_loop() {
       if (!send_frame(frame, view, view.settings.mode == "full" ? 0.0 : budget_ms)) return;
       const double sent_ms = send.elapsed_ms();
       overhead_ms = 0.5 * (overhead_ms + sent_ms);  // smoothed: one slow send does not halve a budget
-      scene_.stats->frame_sent(view.settings.mode, frame.ms, frame.ms + sent_ms);
+      if (is_new && view.settings.mode == "prioritized" && !frame.converged)
+        overrun_ms = 0.5 * (overrun_ms + std::max(frame.ms - budget_ms, 0.0));      scene_.stats->frame_sent(view.settings.mode, frame.ms, frame.ms + sent_ms);
     } catch (const Cancelled&) {
       if (cancel_) return;  // else a refinement superseded by a newer view: the loop renders that one next
     } catch (const std::exception& e) {
