@@ -283,7 +283,8 @@ TEST(ServeProtocol, TwoClientsWithDifferentCamerasEachGetTheirOwnView) {
 
 TEST(ServeProtocol, CameraMessagesAreCoalescedToTheLatest) {
   const std::string dir = make_torus_dir("serve_coalesce");
-  ServeProcess server(dir, "torus.vdb --tf tf.json --target-fps 5");
+  // 1 fps: the 20 messages must merely arrive within a second or two, which holds under a sanitizer at -j2 too.
+  ServeProcess server(dir, "torus.vdb --tf tf.json --target-fps 1");
   WsClient client(server.port());
   for (int seq = 1; seq <= 20; ++seq) client.send(camera_message(client.hello(), seq, {double(seq), 20, 60}));
   std::set<int> rendered;
@@ -297,7 +298,7 @@ TEST(ServeProtocol, CameraMessagesAreCoalescedToTheLatest) {
     rendered.insert(seq);
     if (seq == 20 && f.header["converged"] == true) break;
   }
-  EXPECT_LE(rendered.size(), 3u);  // at 5 fps the 20 messages (sent within ms) fit in one or two frame periods
+  EXPECT_LE(rendered.size(), 3u);  // the 20 messages (sent within ms) fit in one or two frame periods
 }
 
 TEST(ServeProtocol, ShowTracedSendsTheTracedRayMask) {
