@@ -12,7 +12,9 @@ namespace raysift::server {
 /// How a connection's messages leave; callable from any thread, in order of the calls.
 struct MessageSink {
   std::function<void(std::string)> text;                  ///< queued; returns at once
-  std::function<bool(std::vector<std::uint8_t>)> binary;  ///< returns once written; false once the connection is gone
+  /// A text header and its binary message, adjacent (another thread's text never comes between them); returns
+  /// once both are written; false once the connection is gone.
+  std::function<bool(std::string, std::vector<std::uint8_t>)> frame;
 };
 
 /// What one WebSocket connection runs. Destroyed on the transport's thread when the connection ends: the

@@ -42,21 +42,35 @@ RenderedFrame from_sampled(const sampling::SampledFrame& f, const volume::RayCas
 
 }  // namespace
 
-RenderedFrame FrameRenderer::full_frame(const volume::RayCaster& caster, const FrameRequest& request, double setup_ms) {
+RenderedFrame FrameRenderer::full_frame(const FrameRequest& request, double setup_ms, bool supersedable) {
   const Timer timer;
   const std::atomic<bool>* cancel = request.cancel;
-  volume::RenderResult r = volume::render_full(caster, [cancel](double) {
+  const std::atomic<std::uint64_t>* latest = supersedable ? request.latest_version : nullptr;
+  const std::uint64_t version = request.version;
+  volume::RenderResult r = volume::render_full(*caster_, [cancel, latest, version](double) {
     if (cancel && cancel->load(std::memory_order_relaxed)) throw Cancelled("the viewer left");
+    if (latest && latest->load(std::memory_order_relaxed) != version) throw Cancelled("the view changed");
   });
   RenderedFrame out;
   out.image = std::move(r.image);
-  const Image<std::uint8_t> background = caster.background_mask();
+  const Image<std::uint8_t> background = caster_->background_mask();
   out.traced = ImageF(background.width, background.height);
   for (std::size_t i = 0; i < background.size(); ++i) out.traced.pixels[i] = background.pixels[i] ? 0.0f : 1.0f;
-  out.rays_traced = out.full_rays = std::size_t(r.rays_traced);
+  // Counted as a sampled frame counts (object pixels; render_full's rays_traced is every pixel), so that a full
+  // frame's header and traced mask agree and full_rays does not depend on which kind of frame was sent.
+  out.rays_traced = out.full_rays = std::size_t(std::count(out.traced.pixels.begin(), out.traced.pixels.end(), 1.0f));
   out.ms = setup_ms + timer.elapsed_ms();
   out.converged = converged_ = true;
+  const std::optional<double> known = full_ms(request);  // smoothed: one frame slowed by the load is not the cost
+  full_cost_ = FullCost{request.camera.width, request.camera.height, request.render, known ? 0.5 * (*known + out.ms) : out.ms};
   return out;
+}
+
+std::optional<double> FrameRenderer::full_ms(const FrameRequest& request) const {
+  if (!full_cost_ || full_cost_->width != request.camera.width || full_cost_->height != request.camera.height ||
+      full_cost_->render != request.render)
+    return std::nullopt;
+  return full_cost_->ms;
 }
 
 RenderedFrame FrameRenderer::first_frame(const FrameRequest& request) {
@@ -66,8 +80,12 @@ RenderedFrame FrameRenderer::first_frame(const FrameRequest& request) {
   caster_.reset(new volume::RayCaster(request.render->caster(request.camera, k)));  // not movable: built in place
   sampler_.reset();
   converged_ = false;
-  if (request.mode == "full") return full_frame(*caster_, request, total.elapsed_ms());
   const bool prioritized = request.mode == "prioritized";
+  // A prioritized frame's fixed costs (importance, priorities, reconstruction) do not shrink with the budget:
+  // when the whole frame fits, the full frame is both cheaper and the converged image.
+  const std::optional<double> full = full_ms(request);
+  if (request.mode == "full" || (prioritized && full && *full <= request.budget_ms))
+    return full_frame(request, total.elapsed_ms(), false);
   sampling::SampledRenderRequest cli = cli_request(request.mode);
   cli.features.classes = request.classes;
   // As the CLI: only the prioritized mode's importance comes from the feature lines.
@@ -91,7 +109,7 @@ RenderedFrame FrameRenderer::first_frame(const FrameRequest& request) {
 
 RenderedFrame FrameRenderer::refine(const FrameRequest& request) {
   RAYSIFT_CHECK(caster_ != nullptr);
-  if (request.mode != "prioritized") return full_frame(*caster_, request, 0.0);
+  if (request.mode != "prioritized" || !full_ms(request)) return full_frame(request, 0.0, true);
   const Timer total;
   if (!sampler_) {
     sampling::SamplingOptions options = cli_request(request.mode).sampling;

@@ -2,6 +2,7 @@
 /// \file The frames of one viewer: a budgeted frame whenever the view changed, then progressive refinement of
 /// the same view until it converges to the full render (which is what `raysift render` gives for it).
 #include <atomic>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -22,6 +23,10 @@ struct FrameRequest {
   features::LineClassSet classes;
   double budget_ms = 100;                                 ///< for the render alone (encode and send excluded)
   const std::atomic<bool>* cancel = nullptr;              ///< stops a full render (Cancelled)
+  /// A refinement's full render also stops (Cancelled) once `*latest_version != version`: a camera message must
+  /// not wait behind a converging frame of a view already left.
+  const std::atomic<std::uint64_t>* latest_version = nullptr;
+  std::uint64_t version = 0;
 };
 
 /// A composited frame (colour over the background, alpha 1 as a PNG shows it) and its buffers.
@@ -36,21 +41,34 @@ struct RenderedFrame {
 
 class FrameRenderer {
  public:
-  /// The first frame of a new view (camera, TF or settings changed): prioritized with a time budget, subsample
+  /// The first frame of a new view (camera, TF or settings changed): prioritized with a time budget (or the full
+  /// frame when this renderer's measured full-frame time for the view size and TF fits the budget), subsample
   /// with a ray fraction steered to the budget, or full. Starts a new refinement.
   /// \throw InvalidInput for a bad camera; Cancelled.
   RenderedFrame first_frame(const FrameRequest& request);
   /// The next refinement frame of the view of the last first_frame(): the prioritized queue continued within the
-  /// budget; the other modes finish with one full render. \pre !converged().
+  /// budget (or one full render when the full-frame time of this size and TF is not yet measured: that measures
+  /// it); the other modes finish with one full render. \pre !converged().
   RenderedFrame refine(const FrameRequest& request);
   bool converged() const { return converged_; }
 
  private:
-  RenderedFrame full_frame(const volume::RayCaster& caster, const FrameRequest& request, double setup_ms);
+  /// \param supersedable also stop when the view changed (refinement frames).
+  RenderedFrame full_frame(const FrameRequest& request, double setup_ms, bool supersedable);
+  /// The measured full-frame time (set-up + trace + compositing) of the request's size and TF, if known.
+  std::optional<double> full_ms(const FrameRequest& request) const;
+
+  /// The last full frame's cost; a new size or TF forgets it (one key: a session renders one view at a time).
+  struct FullCost {
+    int width = 0, height = 0;
+    const app::RenderSession* render = nullptr;
+    double ms = 0;
+  };
 
   std::unique_ptr<volume::RayCaster> caster_;                 ///< of the view being refined
   std::optional<sampling::ProgressiveSampler> sampler_;
   ImageF importance_;
+  std::optional<FullCost> full_cost_;
   bool converged_ = true;
   double subsample_fraction_ = 0.25;  ///< steered frame by frame to the budget
 };

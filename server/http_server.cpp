@@ -37,11 +37,15 @@ class Outbox {
     std::string data;
     std::uint64_t id = 0;
   };
-  /// The message's id, or 0 once the connection is closed.
-  std::uint64_t push(bool is_binary, std::string data) {
+  /// Queues the messages next to each other (no other thread's message between them); the last one's id, or 0
+  /// once the connection is closed.
+  std::uint64_t push(std::vector<Message> messages) {
     const std::lock_guard<std::mutex> lock(mutex_);
     if (closed_) return 0;
-    queue_.push_back({is_binary, std::move(data), ++pushed_});
+    for (Message& m : messages) {
+      m.id = ++pushed_;
+      queue_.push_back(std::move(m));
+    }
     return pushed_;
   }
   bool pop(Message& m) {
@@ -110,10 +114,16 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     };
     MessageSink sink;
     sink.text = [outbox = outbox_, kick](std::string s) {
-      if (outbox->push(false, std::move(s)) != 0) kick();
+      std::vector<Outbox::Message> messages(1);
+      messages[0].data = std::move(s);
+      if (outbox->push(std::move(messages)) != 0) kick();
     };
-    sink.binary = [outbox = outbox_, kick](std::vector<std::uint8_t> bytes) {
-      const std::uint64_t id = outbox->push(true, std::string(bytes.begin(), bytes.end()));
+    sink.frame = [outbox = outbox_, kick](std::string header, std::vector<std::uint8_t> bytes) {
+      std::vector<Outbox::Message> messages(2);
+      messages[0].data = std::move(header);
+      messages[1].is_binary = true;
+      messages[1].data.assign(bytes.begin(), bytes.end());
+      const std::uint64_t id = outbox->push(std::move(messages));
       if (id == 0) return false;
       kick();
       return outbox->wait_sent(id);

@@ -1,5 +1,6 @@
 #include "server/viewer_session.h"
 
+#include <algorithm>
 #include <charconv>
 #include <chrono>
 #include <cstdlib>
@@ -150,7 +151,7 @@ void ViewerSession::apply_camera(const Json& message) {
   const std::lock_guard<std::mutex> lock(mutex_);
   view_.camera = spec;
   view_.camera_seq = seq;
-  ++view_.version;
+  bump_version();
   cv_.notify_all();
 }
 
@@ -163,7 +164,7 @@ void ViewerSession::apply_tf(const Json& message) {
                         {"features_ready", false}};
   const std::lock_guard<std::mutex> lock(mutex_);
   view_.render = std::move(render);  // frames keep the old geometry until the new one is built
-  ++view_.version;
+  bump_version();
   ++geometry_wanted_;
   geometry_cancel_ = true;  // a build for an older TF is no longer wanted
   sink_.text(applied.dump());  // under the lock: before the geometry thread's features_ready
@@ -190,8 +191,13 @@ void ViewerSession::apply_settings(const Json& message) {
   if (message.contains("format")) s.format = one_of(message, "format", image_formats());
   const std::lock_guard<std::mutex> lock(mutex_);
   view_.settings = s;
-  ++view_.version;
+  bump_version();
   cv_.notify_all();
+}
+
+void ViewerSession::bump_version() {
+  ++view_.version;
+  latest_version_.store(view_.version, std::memory_order_relaxed);
 }
 
 bool ViewerSession::next_view(std::uint64_t rendered, bool converged, View& view) {
@@ -211,6 +217,7 @@ void ViewerSession::render_loop() {
   FrameRenderer renderer;
   std::uint64_t rendered = 0;
   double overhead_ms = 0;  // encode + send of the last frame, taken off the next budget
+  double overrun_ms = 0;   // by how much budgeted renders exceed their budget, also taken off: the latency target
   auto next_start = std::chrono::steady_clock::now();
   View view;
   while (next_view(rendered, renderer.converged(), view)) {
@@ -224,7 +231,7 @@ void ViewerSession::render_loop() {
       next_start = std::chrono::steady_clock::now() + std::chrono::microseconds(std::int64_t(period_ms * 1000));
     }
     rendered = view.version;
-    const double budget_ms = std::max(period_ms - overhead_ms, 0.1 * period_ms);
+    const double budget_ms = std::max(period_ms - overhead_ms - overrun_ms, 0.1 * period_ms);
     FrameRequest request;
     request.render = view.render.get();
     request.camera = view.camera;
@@ -233,6 +240,8 @@ void ViewerSession::render_loop() {
     request.classes = sampling::parse_feature_list(join(view.settings.features));
     request.budget_ms = budget_ms;
     request.cancel = &cancel_;
+    request.latest_version = &latest_version_;
+    request.version = view.version;
     try {
       const RenderedFrame frame = is_new ? renderer.first_frame(request) : renderer.refine(request);
       if (!is_new && superseded(rendered)) continue;  // a refinement of a view already left: not worth encoding
@@ -240,9 +249,11 @@ void ViewerSession::render_loop() {
       if (!send_frame(frame, view, view.settings.mode == "full" ? 0.0 : budget_ms)) return;
       const double sent_ms = send.elapsed_ms();
       overhead_ms = 0.5 * (overhead_ms + sent_ms);  // smoothed: one slow send does not halve a budget
-      scene_.stats->frame_sent(view.settings.mode, frame.ms, frame.ms + sent_ms);
+      if (is_new && view.settings.mode == "prioritized" && !frame.converged)
+        // Capped: when the fixed costs alone exceed the budget, a smaller budget only loses rays, not time.
+        overrun_ms = std::min(0.5 * (overrun_ms + std::max(frame.ms - budget_ms, 0.0)), 0.25 * period_ms);      scene_.stats->frame_sent(view.settings.mode, frame.ms, frame.ms + sent_ms);
     } catch (const Cancelled&) {
-      return;
+      if (cancel_) return;  // else a refinement superseded by a newer view: the loop renders that one next
     } catch (const std::exception& e) {
       renderer = FrameRenderer();  // nothing to refine until the view changes
       sink_.text(error_json(std::string("frame failed: ") + e.what()).dump());
@@ -264,8 +275,7 @@ bool ViewerSession::send_frame(const RenderedFrame& frame, const View& view, dou
                         {"camera_seq", view.camera_seq}, {"mode", view.settings.mode},
                         {"width", frame.image.width}, {"height", frame.image.height},
                         {"format", view.settings.format}};
-  sink_.text(message.dump());
-  return sink_.binary(std::move(bytes));
+  return sink_.frame(message.dump(), std::move(bytes));
 }
 
 void ViewerSession::geometry_loop() {

@@ -70,6 +70,7 @@ class ViewerSession : public ConnectionHandler {
   /// Waits until the view changed, refinement is pending, or the session stops (then false).
   bool next_view(std::uint64_t rendered, bool converged, View& view);
   bool superseded(std::uint64_t version);
+  void bump_version();  ///< \pre mutex_ held
   bool send_frame(const RenderedFrame& frame, const View& view, double budget_ms);
 
   const ServeScene& scene_;
@@ -80,6 +81,7 @@ class ViewerSession : public ConnectionHandler {
   bool stopping_ = false;
   std::uint64_t geometry_wanted_ = 1;  ///< bumped by each TF; the geometry thread builds for the newest
   std::atomic<bool> cancel_{false}, geometry_cancel_{false};
+  std::atomic<std::uint64_t> latest_version_{1};  ///< view_.version, read by a refinement's full render
   std::uint64_t frame_seq_ = 0;
   std::thread render_thread_, geometry_thread_;
 };

@@ -28,7 +28,7 @@ namespace http = beast::http;
 namespace websocket = beast::websocket;
 using tcp = net::ip::tcp;
 
-constexpr int kTimeoutS = 20;
+constexpr int kTimeoutS = 60;  // a hang guard only: generous for a sanitizer build next to other tests
 
 /// Connected socket whose blocking reads fail after kTimeoutS instead of hanging.
 tcp::socket connect_socket(net::io_context& io, int port) {
@@ -65,7 +65,7 @@ ServeProcess::ServeProcess(const std::string& dir, const std::string& args) : di
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
-  throw std::runtime_error("raysift serve printed no URL within 20 s: " + stderr_text());
+  throw std::runtime_error("raysift serve printed no URL within " + std::to_string(kTimeoutS) + " s: " + stderr_text());
 }
 
 ServeProcess::~ServeProcess() {

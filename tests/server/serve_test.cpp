@@ -171,6 +171,22 @@ TEST(ServeProtocol, ConvergedPngFrameIsByteEqualToTheCliPng) {
   EXPECT_EQ(f.image, cli_png(dir, camera, "tf.json", "a"));
 }
 
+// The first view's convergence measures the full frame's cost; whether the second view's frames are then full
+// frames (the cost fits the budget) or prioritized ones refined progressively depends on the machine's speed, so
+// the test asserts what holds on both paths: the converged frame is the CLI's PNG.
+TEST(ServeProtocol, AViewAfterTheFullFrameCostIsKnownConvergesToTheCliPng) {
+  const std::string dir = make_torus_dir("serve_known_cost");
+  ServeProcess server(dir, "torus.vdb --tf tf.json --target-fps 120");
+  WsClient client(server.port());
+  client.send(camera_message(client.hello(), 1, {30, -40, 60}));
+  static_cast<void>(client.read_converged(1));
+  const Json camera = camera_message(client.hello(), 2, {-35, 20, 55});
+  client.send(camera);
+  const ServeFrame f = client.read_converged(2);
+  EXPECT_EQ(f.header["rays_traced"], f.header["full_rays"]);
+  EXPECT_EQ(f.image, cli_png(dir, camera, "tf.json", "k"));
+}
+
 TEST(ServeProtocol, OneThreadConvergesToTheBytesOfTheCliOnAllCores) {
   const std::string dir = make_torus_dir("serve_one_thread");
   ServeProcess server(dir, "torus.vdb --tf tf.json --threads 1");
@@ -283,7 +299,8 @@ TEST(ServeProtocol, TwoClientsWithDifferentCamerasEachGetTheirOwnView) {
 
 TEST(ServeProtocol, CameraMessagesAreCoalescedToTheLatest) {
   const std::string dir = make_torus_dir("serve_coalesce");
-  ServeProcess server(dir, "torus.vdb --tf tf.json --target-fps 5");
+  // 1 fps: the 20 messages must merely arrive within a second or two, which holds under a sanitizer at -j2 too.
+  ServeProcess server(dir, "torus.vdb --tf tf.json --target-fps 1");
   WsClient client(server.port());
   for (int seq = 1; seq <= 20; ++seq) client.send(camera_message(client.hello(), seq, {double(seq), 20, 60}));
   std::set<int> rendered;
@@ -297,7 +314,7 @@ TEST(ServeProtocol, CameraMessagesAreCoalescedToTheLatest) {
     rendered.insert(seq);
     if (seq == 20 && f.header["converged"] == true) break;
   }
-  EXPECT_LE(rendered.size(), 3u);  // at 5 fps the 20 messages (sent within ms) fit in one or two frame periods
+  EXPECT_LE(rendered.size(), 3u);  // the 20 messages (sent within ms) fit in one or two frame periods
 }
 
 TEST(ServeProtocol, ShowTracedSendsTheTracedRayMask) {
