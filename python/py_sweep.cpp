@@ -28,7 +28,7 @@ std::string sweep_csv(const volume::Volume& v, const volume::TransferFunction& t
   volume::RenderOptions render;
   render.shading = shading == "phong" ? volume::Shading::Phong : volume::Shading::None;
   return run_released([&](const std::atomic<bool>& cancel) {
-    const volume::RayCaster caster(v, volume::build_volume_bricks(v), tf, camera, render);
+    const volume::RayCaster caster(v, tf, camera, render);
     sampling::FeatureGeometry geometry;
     if (!trade.features.classes.is_empty()) {
       // cmd_sweep.cpp's feature_options: the geometry fitted to the sweep's view and importance resolution.
