@@ -119,7 +119,8 @@ def main():
     ap = argparse.ArgumentParser()
     here = os.path.dirname(os.path.abspath(__file__))
     ap.add_argument("--exe", default=os.path.join(here, "..", "build", "raysift"))
-    ap.add_argument("--work", default="/tmp/raysift_distributed_bench")
+    # Inputs and outputs beside the build, not at a fixed machine path.
+    ap.add_argument("--work", default=os.path.join(here, "..", "build", "distributed_bench"))
     ap.add_argument("--ranks", default="1,2,4")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--side", type=int, default=256)
