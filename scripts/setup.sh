@@ -19,7 +19,7 @@ case "$mode" in
   test) build_all=ON  # + tests, the shell tools they call, the Python module with its test runner, Open MPI
                       # (issue 19), Chromium with a DevTools client and Node for the page's tests (issue 18)
         packages+=(libgtest-dev libopenvdb-tools openimageio-tools
-                   pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-openimageio
+                   pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-openimageio python3-matplotlib
                    libopenmpi-dev openmpi-bin chromium python3-websocket python3-pil nodejs) ;;
   *) echo "usage: scripts/setup.sh demo|test" >&2; exit 2 ;;
 esac
