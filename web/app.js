@@ -350,7 +350,8 @@ function update_status() {
   $("st-converged").textContent = s.frames === 0 ? "–" : s.converged ? "yes" : "refining";
   const budget = target ? 1000 / target : null;
   $("st-latency").textContent = `${fmt(s.latency_ms.last, 0, " ms")} (p50 ${fmt(s.latency_ms.p50, 0)}, ` +
-    `p95 ${fmt(s.latency_ms.p95, 0)} ms; p95 ${fmt(budget && s.latency_ms.p95 / budget, 2, "×")} budget)`;
+    `p95 ${fmt(s.latency_ms.p95, 0)} ms; p95 ${fmt(budget && s.latency_ms.p95 / budget, 2, "×")} budget; ` +
+    `rendered-from message p95 ${fmt(budget && s.reflected_latency_ms.p95 / budget, 2, "×")})`;
   $("st-drag").textContent = s.drag ? `${fmt(s.drag.fps, 1, " fps")}, interval p50 ` +
     `${fmt(s.drag.interval_p50_ms, 0, " ms")} (${s.drag.frames} frames)` : "–";
   $("st-features").textContent = state.features_ready === null ? "–" : state.features_ready ? "ready" : "building…";

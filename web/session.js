@@ -11,6 +11,14 @@ export function percentile(values, p) {
   return sorted[Math.min(sorted.length - 1, Math.floor((p / 100) * sorted.length))];
 }
 
+function latency_summary(values) {
+  return {
+    last: values.length ? values[values.length - 1] : null,
+    p50: percentile(values, 50), p95: percentile(values, 95),
+    max: values.length ? Math.max(...values) : null, count: values.length,
+  };
+}
+
 export class Session {
   /// handlers: hello(msg), frame(meta), tf_applied(msg), features_ready(), error(text), closed(text).
   constructor(url, canvas, handlers) {
@@ -20,6 +28,7 @@ export class Session {
     this.draw_chain = Promise.resolve();
     this.sent_camera = new Map();    // seq -> performance.now() when sent, until a frame reflects it
     this.latencies_ms = [];          // camera message -> first pixels drawn that reflect it
+    this.reflected_latencies_ms = []; // the same, only for the message each frame was rendered from
     this.draw_times = [];            // performance.now() of recent draws, for the achieved rate
     this.drag = null;                // {start, draws: [t...]} while (or after) the user drags
     this.frames = 0;
@@ -88,15 +97,19 @@ export class Session {
     this.handlers.frame?.(meta);
   }
 
-  /// Every camera message up to camera_seq is now on screen: its latency is now - its send time.
+  /// Every camera message up to camera_seq is now on screen: its latency is now - its send time. Messages the
+  /// server coalesced (superseded while a frame was in flight) count too, so this is the latency a user feels;
+  /// the frame's own message (camera_seq) is kept apart, as the server's part of it.
   record_latency(camera_seq, now) {
     if (typeof camera_seq !== "number") return;
     for (const [seq, sent] of this.sent_camera) {
       if (seq > camera_seq) continue;
       this.latencies_ms.push(now - sent);
+      if (seq === camera_seq) this.reflected_latencies_ms.push(now - sent);
       this.sent_camera.delete(seq);
     }
-    if (this.latencies_ms.length > LATENCY_KEEP) this.latencies_ms.splice(0, this.latencies_ms.length - LATENCY_KEEP);
+    for (const list of [this.latencies_ms, this.reflected_latencies_ms])
+      if (list.length > LATENCY_KEEP) list.splice(0, list.length - LATENCY_KEEP);
   }
 
   /// A drag's frame rate counts the frames that reflect its camera messages, from the first to its end.
@@ -119,11 +132,8 @@ export class Session {
       show: last ? last.show : null,
       seq: last ? last.seq : null,
       camera_seq: last ? last.camera_seq : null,
-      latency_ms: {
-        last: this.latencies_ms.length ? this.latencies_ms[this.latencies_ms.length - 1] : null,
-        p50: percentile(this.latencies_ms, 50), p95: percentile(this.latencies_ms, 95),
-        max: this.latencies_ms.length ? Math.max(...this.latencies_ms) : null, count: this.latencies_ms.length,
-      },
+      latency_ms: latency_summary(this.latencies_ms),
+      reflected_latency_ms: latency_summary(this.reflected_latencies_ms),
       drag: this.drag_stats(),
     };
   }
