@@ -139,11 +139,37 @@ std::uint32_t next_epoch(Image<Cell>& cells) {
   return epoch;
 }
 
+// One byte per pixel in 8 x 8 tiles of one cache line each (this thread's buffer, reused like the cells). A traced
+// pixel's children and their corners lie within S/2 of it, so the offers' tests touch a few lines; in rows, each
+// test read another row's line of a 1.3 MB mask (at 1440x900) that does not stay in L2 (perf: most of the offers'
+// time was on these reads).
+class TiledBytes {
+ public:
+  TiledBytes(int w, int h)
+      : width_(std::uint32_t(w)), tiles_x_((std::size_t(w) + 7) / 8),
+        bytes_(frame_buffer<std::uint8_t>(int(tiles_x_ * 8), (h + 7) / 8 * 8).pixels) {}
+  std::size_t at(int x, int y) const { return (std::size_t(y >> 3) * tiles_x_ << 6 | std::size_t((y & 7) << 3)) + column(x); }
+  /// at(x, y) - at(0, y)
+  static std::size_t column(int x) { return std::size_t(x >> 3) << 6 | std::size_t(x & 7); }
+  std::size_t at(std::uint32_t pixel) const { return at(int(pixel % width_), int(pixel / width_)); }
+  std::uint8_t& operator[](std::size_t i) { return bytes_[i]; }
+  /// Row y's bytes, pixel x at row(y)[column(x)].
+  std::uint8_t* row(int y) { return &bytes_[at(0, y)]; }
+  const std::uint8_t* row(int y) const { return &bytes_[at(0, y)]; }
+  std::uint8_t operator[](std::size_t i) const { return bytes_[i]; }
+
+ private:
+  std::uint32_t width_;
+  std::size_t tiles_x_;
+  std::vector<std::uint8_t>& bytes_;
+};
+
 // A candidate whose corners are known, with its known parents.
 struct Ready {
   std::uint32_t pixel;
   int level;
   int known;  ///< parents[0, known)
+  unsigned background;  ///< bit i: parents[i] is background
   std::array<std::uint32_t, 4> parents;
 };
 
@@ -174,19 +200,29 @@ class Refiner {
           std::uint64_t seed, ImageRGBA& image, ImageMask& traced)
       : imp_(importance), pattern_(pattern), options_(options), image_(image), traced_(traced),
         cells_(frame_buffer<Cell>(importance.width, importance.height)), epoch_(next_epoch(cells_)),
-        state_(frame_buffer<std::uint8_t>(importance.width, importance.height)), queue_(seed) {
-    // One pass per row of S x S blocks: the state mask and which blocks hold background.
-    const int s = pattern_.base_spacing, bw = (imp_.width + s - 1) / s, bh = (imp_.height + s - 1) / s;
+        state_(importance.width, importance.height), queue_(seed) {
+    // One pass over the S x S blocks, block by block: the state mask and which blocks hold background or object
+    // pixels. Per pixel, only compares and byte stores (a block index per pixel cost a division each).
+    const int s = pattern_.base_spacing, w = imp_.width, h = imp_.height, bw = (w + s - 1) / s, bh = (h + s - 1) / s;
     Image<std::uint8_t> has_background(bw, bh, 0), has_object(bw, bh, 0);
     parallel_rows(bh, [&](int by) {
-      for (int y = by * s; y < std::min(imp_.height, (by + 1) * s); ++y) {
-        const std::size_t row = std::size_t(y) * std::size_t(imp_.width);
-        for (int x = 0; x < imp_.width; ++x) {
-          const std::size_t i = row + std::size_t(x);
-          const bool background = imp_.pixels[i] < 0;
-          state_.pixels[i] = background ? kKnown | kBackground : traced_.pixels[i] ? kKnown : 0;
-          (background ? has_background : has_object)(x / s, by) = 1;
+      for (int bx = 0; bx < bw; ++bx) {
+        std::uint8_t background = 0, object = 0;
+        for (int y = by * s; y < std::min(h, (by + 1) * s); ++y) {
+          // Raw pointers: through the byte stores the compiler would reload every captured reference per pixel.
+          const float* imp = &imp_.pixels[std::size_t(y) * std::size_t(w)];
+          const std::uint8_t* traced = &traced_.pixels[std::size_t(y) * std::size_t(w)];
+          std::uint8_t* state = state_.row(y);
+          const int x1 = std::min(w, (bx + 1) * s);
+          for (int x = bx * s; x < x1; ++x) {
+            const std::uint8_t is_background = imp[x] < 0 ? 1 : 0;
+            state[TiledBytes::column(x)] = is_background ? kKnown | kBackground : traced[x] ? kKnown : 0;
+            background |= is_background;
+            object |= is_background ^ 1;
+          }
         }
+        has_background(bx, by) = background;
+        has_object(bx, by) = object;
       }
     });
     mark_open_blocks(has_background);
@@ -199,23 +235,24 @@ class Refiner {
   // Candidates no traced parent will offer: every in-image parent is background.
   // Their parents lie within S/2, so only open blocks (see mark_open_blocks) with object pixels can hold them.
   void offer_orphans() {
-    push(gather(std::size_t(imp_.height), 16, [this](std::size_t y0, std::size_t y1, std::vector<Candidate>& out) {
+    const int s = pattern_.base_spacing;
+    push(gather(std::size_t(orphan_blocks_.height), 2, [this, s](std::size_t by0, std::size_t by1,
+                                                                 std::vector<Candidate>& out) {
       std::vector<Ready> ready;
-      const int s = pattern_.base_spacing;
-      for (int y = int(y0); y < int(y1); ++y)
-        for (int x = 0; x < imp_.width; ++x) {
-          if (!orphan_blocks_(x / s, y / s)) {
-            x += s - 1 - x % s;  // the rest of this block's row
-            continue;
-          }
-          const int level = pattern_.level(x, y);
-          if (level == 0 || imp_(x, y) < 0) continue;
-          bool orphan = true;
-          for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
-            const int px = x + o[0], py = y + o[1];
-            orphan = orphan && (px < 0 || py < 0 || px >= imp_.width || py >= imp_.height || imp_(px, py) < 0);
-          }
-          if (orphan) list_ready(x, y, level, ready, kNoSource);
+      for (int by = int(by0); by < int(by1); ++by)
+        for (int bx = 0; bx < orphan_blocks_.width; ++bx) {
+          if (!orphan_blocks_(bx, by)) continue;
+          for (int y = by * s; y < std::min(imp_.height, (by + 1) * s); ++y)
+            for (int x = bx * s; x < std::min(imp_.width, (bx + 1) * s); ++x) {
+              const int level = pattern_.level(x, y);
+              if (level == 0 || imp_(x, y) < 0) continue;
+              bool orphan = true;
+              for (const auto& o : parent_offsets(level, s)) {
+                const int px = x + o[0], py = y + o[1];
+                orphan = orphan && (px < 0 || py < 0 || px >= imp_.width || py >= imp_.height || imp_(px, py) < 0);
+              }
+              if (orphan) list_ready(x, y, level, ready, kNoSource);
+            }
         }
       for (const Ready& r : ready) evaluate(r, out);
     }));
@@ -226,7 +263,7 @@ class Refiner {
   void add_traced(const std::vector<std::uint32_t>& pixels, bool offer = true) {
     parallel_for_each(pixels.size(), [&](std::size_t i) {
       traced_.pixels[pixels[i]] = 1;
-      state_.pixels[pixels[i]] |= offer ? kKnown | kFresh : kKnown;
+      state_[state_.at(pixels[i])] |= offer ? kKnown | kFresh : kKnown;
       if (offer) record(pixels[i]);
     }, true, std::size_t(1024));
     if (!offer) return;
@@ -235,7 +272,7 @@ class Refiner {
           evaluate_all(last - first, [&](std::size_t i, std::vector<Ready>& ready) { children(pixels[first + i], ready); },
                        out);
         });
-    parallel_for_each(pixels.size(), [&](std::size_t i) { state_.pixels[pixels[i]] &= std::uint8_t(~kFresh); }, true,
+    parallel_for_each(pixels.size(), [&](std::size_t i) { state_[state_.at(pixels[i])] &= std::uint8_t(~kFresh); }, true,
                       std::size_t(1024));
     push(candidates);
   }
@@ -245,8 +282,8 @@ class Refiner {
     std::vector<std::uint32_t> batch;
     while (batch.size() < count && queue_.size() > 0)
       for (std::uint32_t p : queue_.pop(count - batch.size()))
-        if (!(state_.pixels[p] & kTaken)) {
-          state_.pixels[p] |= kTaken;
+        if (!(state_[state_.at(p)] & kTaken)) {
+          state_[state_.at(p)] |= kTaken;
           batch.push_back(p);
         }
     return batch;
@@ -258,8 +295,9 @@ class Refiner {
   void known_mask(ImageMask& out) const {
     out = ImageMask(imp_.width, imp_.height, 0);
     parallel_rows(imp_.height, [&](int y) {
-      const std::size_t row = std::size_t(y) * std::size_t(imp_.width);
-      for (std::size_t i = row; i < row + std::size_t(imp_.width); ++i) out.pixels[i] = state_.pixels[i] & kKnown;
+      std::uint8_t* known = &out.pixels[std::size_t(y) * std::size_t(imp_.width)];
+      const std::uint8_t* state = state_.row(y);
+      for (int x = 0; x < out.width; ++x) known[x] = state[TiledBytes::column(x)] & kKnown;
     });
   }
 
@@ -293,7 +331,7 @@ class Refiner {
   void children(std::uint32_t pixel, std::vector<Ready>& ready) const {
     const int w = imp_.width, qx = int(pixel % std::uint32_t(w)), qy = int(pixel / std::uint32_t(w));
     const int lq = fractal_level(qx, qy, pattern_.base_spacing);
-    const bool open = open_(qx / pattern_.base_spacing, qy / pattern_.base_spacing) != 0;
+    const bool open = open_(qx >> block_shift_, qy >> block_shift_) != 0;
     const int end = open ? pattern_.num_levels : std::min(pattern_.num_levels, lq + 3);
     for (int level = lq + 1; level < end; ++level)
       for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
@@ -305,8 +343,7 @@ class Refiner {
 
   // Whether traced pixel (px, py) lists its children of `level` (see children()).
   bool lists(int px, int py, int level) const {
-    const int s = pattern_.base_spacing;
-    return open_(px / s, py / s) != 0 || level < fractal_level(px, py, s) + 3;
+    return open_(px >> block_shift_, py >> block_shift_) != 0 || level < fractal_level(px, py, pattern_.base_spacing) + 3;
   }
 
   // Appends (x, y) of `level` to `ready` unless it is known, taken or waits for a corner, decided on the small
@@ -317,30 +354,33 @@ class Refiner {
   // The record is written in place: built on the stack, its narrow stores were reloaded as one wide copy into
   // the vector, a store-forwarding stall per child (perf: a fifth of the offers' time).
   void list_ready(int x, int y, int level, std::vector<Ready>& ready, std::uint32_t source) const {
-    if (state_(x, y) != 0) return;
+    if (state_[state_.at(x, y)] != 0) return;
     const int lattice_mask = 2 * parent_offset(level, pattern_.base_spacing) - 1;
     Ready& r = ready.emplace_back();
     r.pixel = std::uint32_t(y) * std::uint32_t(imp_.width) + std::uint32_t(x);
     r.level = level;
     r.known = 0;
+    r.background = 0;
     for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
       const int px = x + o[0], py = y + o[1];
       if (px < 0 || py < 0 || px >= imp_.width || py >= imp_.height) continue;
       const std::uint32_t parent = std::uint32_t(py) * std::uint32_t(imp_.width) + std::uint32_t(px);
-      if (parent < source && (state_.pixels[parent] & kFresh) && lists(px, py, level)) {
+      const std::uint8_t parent_state = state_[state_.at(px, py)];
+      if (parent < source && (parent_state & kFresh) && lists(px, py, level)) {
         ready.pop_back();  // that parent lists it
         return;
       }
       // Required: the corners of the square cell being split (for an edge midpoint, the edge's two ends).
       // The squares' centres beside an edge midpoint only add contrast: requiring them would let a flat
       // neighbour cell block the refinement of an edge cell.
-      if (!(state_(px, py) & kKnown)) {
+      if (!(parent_state & kKnown)) {
         if ((px & lattice_mask) == 0 && (py & lattice_mask) == 0) {
           ready.pop_back();  // offered again when it is traced
           return;
         }
         continue;
       }
+      r.background |= parent_state & kBackground ? 1u << r.known : 0u;
       r.parents[std::size_t(r.known++)] = parent;
     }
     for (int i = 0; i < r.known; ++i) __builtin_prefetch(&cells_.pixels[r.parents[std::size_t(i)]]);
@@ -355,7 +395,7 @@ class Refiner {
     constexpr std::array<std::uint8_t, 4> kBackgroundPercept{};  // its image value (0) as record() codes it
     for (int i = 0; i < r.known; ++i) {
       const std::array<std::uint8_t, 4>& c =
-          state_.pixels[r.parents[i]] & kBackground ? kBackgroundPercept : cells_.pixels[r.parents[i]].percept;
+          (r.background >> i) & 1 ? kBackgroundPercept : cells_.pixels[r.parents[i]].percept;
       for (int k = 0; k < 4; ++k) {
         lo[k] = std::min(lo[k], int(c[k]));
         hi[k] = std::max(hi[k], int(c[k]));
@@ -408,8 +448,9 @@ class Refiner {
   static constexpr std::uint32_t kNoSource = 0xFFFFFFFFu;
   /// kKnown: background or traced (kBackground: background); kTaken: popped for tracing; kFresh: traced in the
   /// round whose offers are being listed
-  ImageMask& state_;
+  TiledBytes state_;
   BucketQueue queue_;
+  const int block_shift_ = __builtin_ctz(unsigned(pattern_.base_spacing));  ///< log2 S: x >> it is x's block column
   Image<std::uint8_t> open_;  ///< per S x S block, see mark_open_blocks()
   Image<std::uint8_t> orphan_blocks_;  ///< open blocks holding an object pixel: where offer_orphans() looks
   std::array<float, 16> level_share_;  ///< 2^-level, the share of the frame one ray of a level covers
