@@ -107,18 +107,19 @@ std::array<std::array<int, 2>, 4> parent_offsets(int level, int spacing) {
   return {{{-d, 0}, {d, 0}, {0, -d}, {0, d}}};
 }
 
-// What an offer reads and writes of a pixel whose parents are known, in one 16-byte record: offers touch
-// scattered pixels, and separate images would cost a cache miss each.
-// The cells outlive the frame (frame_buffer, next_epoch): `offered` counts only when the cell's epoch is the
-// frame's, so a new frame bumps the epoch instead of clearing 20 MB. 16-byte aligned: one cache line holds 4.
-struct alignas(16) Cell {
-  /// record()ed values of a traced pixel in 1/255 steps (read only for traced pixels: state_ says which).
-  std::array<std::uint8_t, 4> percept{};
-  std::uint32_t epoch = 0;  ///< frame that last wrote `offered`
-  float offered = 0;       ///< highest priority offered so far in frame `epoch`
+// What an offer reads of a traced parent: its record()ed values in 1/255 steps (read only for traced pixels:
+// state_ says which). In an image of their own: a child's parents are close to each other, so in 4-byte pixels
+// they often share a cache line, which 16-byte records with the offers (as before) never did.
+using Percept = std::array<std::uint8_t, 4>;
+
+// What an offer reads and writes of the child. The offers outlive the frame (frame_buffer, next_epoch): `priority`
+// counts only when the epoch is the frame's, so a new frame bumps the epoch instead of clearing 10 MB.
+struct Offer {
+  std::uint32_t epoch = 0;  ///< frame that last wrote `priority`
+  float priority = 0;       ///< highest priority offered so far in frame `epoch`
 };
 
-// This thread's w x h image of P, contents unspecified: the refinement's 22 MB of state (at 1440x900) is
+// This thread's w x h image of P, contents unspecified: the refinement's 17 MB of state (at 1440x900) is
 // reused from frame to frame, as a fresh allocation costs a page fault every 4 KB.
 template <typename P>
 Image<P>& frame_buffer(int w, int h) {
@@ -127,42 +128,17 @@ Image<P>& frame_buffer(int w, int h) {
   return buffer;
 }
 
-// This thread's cells and the epoch of a new frame over them.
-std::uint32_t next_epoch(Image<Cell>& cells) {
-  thread_local const Cell* owner = nullptr;
+// This thread's offers and the epoch of a new frame over them.
+std::uint32_t next_epoch(Image<Offer>& offers) {
+  thread_local const Offer* owner = nullptr;
   thread_local std::uint32_t epoch = 0;
-  if (owner != cells.pixels.data() || ++epoch == 0) {  // new buffer, or the counter wrapped: clear once
-    std::fill(cells.pixels.begin(), cells.pixels.end(), Cell{});
-    owner = cells.pixels.data();
+  if (owner != offers.pixels.data() || ++epoch == 0) {  // new buffer, or the counter wrapped: clear once
+    std::fill(offers.pixels.begin(), offers.pixels.end(), Offer{});
+    owner = offers.pixels.data();
     epoch = 1;
   }
   return epoch;
 }
-
-// One byte per pixel in 8 x 8 tiles of one cache line each (this thread's buffer, reused like the cells). A traced
-// pixel's children and their corners lie within S/2 of it, so the offers' tests touch a few lines; in rows, each
-// test read another row's line of a 1.3 MB mask (at 1440x900) that does not stay in L2 (perf: most of the offers'
-// time was on these reads).
-class TiledBytes {
- public:
-  TiledBytes(int w, int h)
-      : width_(std::uint32_t(w)), tiles_x_((std::size_t(w) + 7) / 8),
-        bytes_(frame_buffer<std::uint8_t>(int(tiles_x_ * 8), (h + 7) / 8 * 8).pixels) {}
-  std::size_t at(int x, int y) const { return (std::size_t(y >> 3) * tiles_x_ << 6 | std::size_t((y & 7) << 3)) + column(x); }
-  /// at(x, y) - at(0, y)
-  static std::size_t column(int x) { return std::size_t(x >> 3) << 6 | std::size_t(x & 7); }
-  std::size_t at(std::uint32_t pixel) const { return at(int(pixel % width_), int(pixel / width_)); }
-  std::uint8_t& operator[](std::size_t i) { return bytes_[i]; }
-  /// Row y's bytes, pixel x at row(y)[column(x)].
-  std::uint8_t* row(int y) { return &bytes_[at(0, y)]; }
-  const std::uint8_t* row(int y) const { return &bytes_[at(0, y)]; }
-  std::uint8_t operator[](std::size_t i) const { return bytes_[i]; }
-
- private:
-  std::uint32_t width_;
-  std::size_t tiles_x_;
-  std::vector<std::uint8_t>& bytes_;
-};
 
 // A candidate whose corners are known, with its known parents.
 struct Ready {
@@ -199,8 +175,9 @@ class Refiner {
   Refiner(const ImageF& importance, const FractalPattern& pattern, const RefinementOptions& options,
           std::uint64_t seed, ImageRGBA& image, ImageMask& traced)
       : imp_(importance), pattern_(pattern), options_(options), image_(image), traced_(traced),
-        cells_(frame_buffer<Cell>(importance.width, importance.height)), epoch_(next_epoch(cells_)),
-        state_(importance.width, importance.height), queue_(seed) {
+        percepts_(frame_buffer<Percept>(importance.width, importance.height)),
+        offers_(frame_buffer<Offer>(importance.width, importance.height)), epoch_(next_epoch(offers_)),
+        state_(frame_buffer<std::uint8_t>(importance.width, importance.height)), queue_(seed) {
     // One pass over the S x S blocks, block by block: the state mask and which blocks hold background or object
     // pixels. Per pixel, only compares and byte stores (a block index per pixel cost a division each).
     const int s = pattern_.base_spacing, w = imp_.width, h = imp_.height, bw = (w + s - 1) / s, bh = (h + s - 1) / s;
@@ -212,11 +189,11 @@ class Refiner {
           // Raw pointers: through the byte stores the compiler would reload every captured reference per pixel.
           const float* imp = &imp_.pixels[std::size_t(y) * std::size_t(w)];
           const std::uint8_t* traced = &traced_.pixels[std::size_t(y) * std::size_t(w)];
-          std::uint8_t* state = state_.row(y);
+          std::uint8_t* state = &state_.pixels[std::size_t(y) * std::size_t(w)];
           const int x1 = std::min(w, (bx + 1) * s);
           for (int x = bx * s; x < x1; ++x) {
             const std::uint8_t is_background = imp[x] < 0 ? 1 : 0;
-            state[TiledBytes::column(x)] = is_background ? kKnown | kBackground : traced[x] ? kKnown : 0;
+            state[x] = is_background ? kKnown | kBackground : traced[x] ? kKnown : 0;
             background |= is_background;
             object |= is_background ^ 1;
           }
@@ -263,7 +240,7 @@ class Refiner {
   void add_traced(const std::vector<std::uint32_t>& pixels, bool offer = true) {
     parallel_for_each(pixels.size(), [&](std::size_t i) {
       traced_.pixels[pixels[i]] = 1;
-      state_[state_.at(pixels[i])] |= offer ? kKnown | kFresh : kKnown;
+      state_.pixels[pixels[i]] |= offer ? kKnown | kFresh : kKnown;
       if (offer) record(pixels[i]);
     }, true, std::size_t(1024));
     if (!offer) return;
@@ -272,7 +249,7 @@ class Refiner {
           evaluate_all(last - first, [&](std::size_t i, std::vector<Ready>& ready) { children(pixels[first + i], ready); },
                        out);
         });
-    parallel_for_each(pixels.size(), [&](std::size_t i) { state_[state_.at(pixels[i])] &= std::uint8_t(~kFresh); }, true,
+    parallel_for_each(pixels.size(), [&](std::size_t i) { state_.pixels[pixels[i]] &= std::uint8_t(~kFresh); }, true,
                       std::size_t(1024));
     push(candidates);
   }
@@ -282,8 +259,8 @@ class Refiner {
     std::vector<std::uint32_t> batch;
     while (batch.size() < count && queue_.size() > 0)
       for (std::uint32_t p : queue_.pop(count - batch.size()))
-        if (!(state_[state_.at(p)] & kTaken)) {
-          state_[state_.at(p)] |= kTaken;
+        if (!(state_.pixels[p] & kTaken)) {
+          state_.pixels[p] |= kTaken;
           batch.push_back(p);
         }
     return batch;
@@ -296,8 +273,8 @@ class Refiner {
     out = ImageMask(imp_.width, imp_.height, 0);
     parallel_rows(imp_.height, [&](int y) {
       std::uint8_t* known = &out.pixels[std::size_t(y) * std::size_t(imp_.width)];
-      const std::uint8_t* state = state_.row(y);
-      for (int x = 0; x < out.width; ++x) known[x] = state[TiledBytes::column(x)] & kKnown;
+      const std::uint8_t* state = &state_.pixels[std::size_t(y) * std::size_t(imp_.width)];
+      for (int x = 0; x < out.width; ++x) known[x] = state[x] & kKnown;
     });
   }
 
@@ -307,7 +284,7 @@ class Refiner {
   void record(std::uint32_t pixel) {
     const Rgba& c = image_.pixels[pixel];
     auto code = [](float v) { return std::uint8_t(std::lround(255.0f * std::min(1.0f, std::max(0.0f, v)))); };
-    cells_.pixels[pixel].percept = {code(std::sqrt(std::max(0.0f, c.r))), code(std::sqrt(std::max(0.0f, c.g))),
+    percepts_.pixels[pixel] = {code(std::sqrt(std::max(0.0f, c.r))), code(std::sqrt(std::max(0.0f, c.g))),
                               code(std::sqrt(std::max(0.0f, c.b))), code(c.a)};
   }
 
@@ -347,14 +324,14 @@ class Refiner {
   }
 
   // Appends (x, y) of `level` to `ready` unless it is known, taken or waits for a corner, decided on the small
-  // state_ mask alone (most children asked about wait for a corner), and prefetches the cells its priority
+  // state_ mask alone (most children asked about wait for a corner), and prefetches the percepts and the offer its priority
   // reads: these are scattered, and a chunk's priorities are computed after all its children are listed.
   // `source` is the traced parent asking (kNoSource: none). A child whose several parents were traced in one round
   // is listed once, by the lowest-index one: the duplicates would get the same priority and push() would drop them.
   // The record is written in place: built on the stack, its narrow stores were reloaded as one wide copy into
   // the vector, a store-forwarding stall per child (perf: a fifth of the offers' time).
   void list_ready(int x, int y, int level, std::vector<Ready>& ready, std::uint32_t source) const {
-    if (state_[state_.at(x, y)] != 0) return;
+    if (state_(x, y) != 0) return;
     const int lattice_mask = 2 * parent_offset(level, pattern_.base_spacing) - 1;
     Ready& r = ready.emplace_back();
     r.pixel = std::uint32_t(y) * std::uint32_t(imp_.width) + std::uint32_t(x);
@@ -365,7 +342,7 @@ class Refiner {
       const int px = x + o[0], py = y + o[1];
       if (px < 0 || py < 0 || px >= imp_.width || py >= imp_.height) continue;
       const std::uint32_t parent = std::uint32_t(py) * std::uint32_t(imp_.width) + std::uint32_t(px);
-      const std::uint8_t parent_state = state_[state_.at(px, py)];
+      const std::uint8_t parent_state = state_.pixels[parent];
       if (parent < source && (parent_state & kFresh) && lists(px, py, level)) {
         ready.pop_back();  // that parent lists it
         return;
@@ -383,8 +360,8 @@ class Refiner {
       r.background |= parent_state & kBackground ? 1u << r.known : 0u;
       r.parents[std::size_t(r.known++)] = parent;
     }
-    for (int i = 0; i < r.known; ++i) __builtin_prefetch(&cells_.pixels[r.parents[std::size_t(i)]]);
-    __builtin_prefetch(&cells_.pixels[r.pixel]);
+    for (int i = 0; i < r.known; ++i) __builtin_prefetch(&percepts_.pixels[r.parents[std::size_t(i)]]);
+    __builtin_prefetch(&offers_.pixels[r.pixel]);
     __builtin_prefetch(&imp_.pixels[r.pixel]);
   }
 
@@ -395,7 +372,7 @@ class Refiner {
     constexpr std::array<std::uint8_t, 4> kBackgroundPercept{};  // its image value (0) as record() codes it
     for (int i = 0; i < r.known; ++i) {
       const std::array<std::uint8_t, 4>& c =
-          (r.background >> i) & 1 ? kBackgroundPercept : cells_.pixels[r.parents[i]].percept;
+          (r.background >> i) & 1 ? kBackgroundPercept : percepts_.pixels[r.parents[i]];
       for (int k = 0; k < 4; ++k) {
         lo[k] = std::min(lo[k], int(c[k]));
         hi[k] = std::max(hi[k], int(c[k]));
@@ -406,12 +383,12 @@ class Refiner {
     const float contrast = float(spread) * (1.0f / 255.0f);
     const float priority =
         (contrast + options_.floor + options_.line_weight * imp_.pixels[r.pixel]) * level_share_[r.level];
-    if (priority <= 1.05f * offered(cells_.pixels[r.pixel])) return;  // see push()
+    if (priority <= 1.05f * offered(offers_.pixels[r.pixel])) return;  // see push()
     out.push_back({r.pixel, priority, bucket_of(priority)});
   }
 
   // Lists the candidates of `count` sources with list(source, ready), then evaluates them, a few sources at a
-  // time so the prefetched cells are still cached.
+  // time so what was prefetched is still cached.
   template <typename List>
   void evaluate_all(std::size_t count, const List& list, std::vector<Candidate>& out) const {
     std::vector<Ready> ready;
@@ -425,30 +402,31 @@ class Refiner {
   void push(const std::vector<Candidate>& candidates) {
     for (std::size_t i = 0; i < candidates.size(); ++i) {
       const Candidate& c = candidates[i];
-      if (i + 16 < candidates.size()) __builtin_prefetch(&cells_.pixels[candidates[i + 16].pixel]);
+      if (i + 16 < candidates.size()) __builtin_prefetch(&offers_.pixels[candidates[i + 16].pixel]);
       // Offered again when another parent was traced: only a clearly higher priority is worth a second entry.
-      Cell& cell = cells_.pixels[c.pixel];
-      if (c.priority <= 1.05f * offered(cell)) continue;
+      Offer& offer = offers_.pixels[c.pixel];
+      if (c.priority <= 1.05f * offered(offer)) continue;
       queue_.push(c.bucket, c.pixel);
-      cell.offered = c.priority;
-      cell.epoch = epoch_;
+      offer.priority = c.priority;
+      offer.epoch = epoch_;
     }
   }
 
-  float offered(const Cell& cell) const { return cell.epoch == epoch_ ? cell.offered : 0.0f; }
+  float offered(const Offer& offer) const { return offer.epoch == epoch_ ? offer.priority : 0.0f; }
 
   const ImageF& imp_;
   const FractalPattern& pattern_;
   const RefinementOptions& options_;
   ImageRGBA& image_;
   ImageMask& traced_;
-  Image<Cell>& cells_;
+  Image<Percept>& percepts_;
+  Image<Offer>& offers_;
   std::uint32_t epoch_;
   static constexpr std::uint8_t kKnown = 1, kTaken = 2, kBackground = 4, kFresh = 8;
   static constexpr std::uint32_t kNoSource = 0xFFFFFFFFu;
   /// kKnown: background or traced (kBackground: background); kTaken: popped for tracing; kFresh: traced in the
   /// round whose offers are being listed
-  TiledBytes state_;
+  ImageMask& state_;
   BucketQueue queue_;
   const int block_shift_ = __builtin_ctz(unsigned(pattern_.base_spacing));  ///< log2 S: x >> it is x's block column
   Image<std::uint8_t> open_;  ///< per S x S block, see mark_open_blocks()
