@@ -285,7 +285,7 @@ class Refiner {
     const Rgba& c = image_.pixels[pixel];
     auto code = [](float v) { return std::uint8_t(std::lround(255.0f * std::min(1.0f, std::max(0.0f, v)))); };
     percepts_.pixels[pixel] = {code(std::sqrt(std::max(0.0f, c.r))), code(std::sqrt(std::max(0.0f, c.g))),
-                              code(std::sqrt(std::max(0.0f, c.b))), code(c.a)};
+                               code(std::sqrt(std::max(0.0f, c.b))), code(c.a)};
   }
 
   // open_(bx, by) = 1 where the S x S blocks around block (bx, by) hold background (`has`) or reach past the
@@ -320,12 +320,13 @@ class Refiner {
 
   // Whether traced pixel (px, py) lists its children of `level` (see children()).
   bool lists(int px, int py, int level) const {
-    return open_(px >> block_shift_, py >> block_shift_) != 0 || level < fractal_level(px, py, pattern_.base_spacing) + 3;
+    return open_(px >> block_shift_, py >> block_shift_) != 0 ||
+           level < fractal_level(px, py, pattern_.base_spacing) + 3;
   }
 
   // Appends (x, y) of `level` to `ready` unless it is known, taken or waits for a corner, decided on the small
-  // state_ mask alone (most children asked about wait for a corner), and prefetches the percepts and the offer its priority
-  // reads: these are scattered, and a chunk's priorities are computed after all its children are listed.
+  // state_ mask alone (most children asked about wait for a corner), and prefetches the percepts and the offer its
+  // priority reads: these are scattered, and a chunk's priorities are computed after all its children are listed.
   // `source` is the traced parent asking (kNoSource: none). A child whose several parents were traced in one round
   // is listed once, by the lowest-index one: the duplicates would get the same priority and push() would drop them.
   // The record is written in place: built on the stack, its narrow stores were reloaded as one wide copy into
