@@ -107,18 +107,19 @@ std::array<std::array<int, 2>, 4> parent_offsets(int level, int spacing) {
   return {{{-d, 0}, {d, 0}, {0, -d}, {0, d}}};
 }
 
-// What an offer reads and writes of a pixel whose parents are known, in one 16-byte record: offers touch
-// scattered pixels, and separate images would cost a cache miss each.
-// The cells outlive the frame (frame_buffer, next_epoch): `offered` counts only when the cell's epoch is the
-// frame's, so a new frame bumps the epoch instead of clearing 20 MB. 16-byte aligned: one cache line holds 4.
-struct alignas(16) Cell {
-  /// record()ed values of a traced pixel in 1/255 steps (read only for traced pixels: state_ says which).
-  std::array<std::uint8_t, 4> percept{};
-  std::uint32_t epoch = 0;  ///< frame that last wrote `offered`
-  float offered = 0;       ///< highest priority offered so far in frame `epoch`
+// What an offer reads of a traced parent: its record()ed values in 1/255 steps (read only for traced pixels:
+// state_ says which). In an image of their own: a child's parents are close to each other, so in 4-byte pixels
+// they often share a cache line, which 16-byte records with the offers (as before) never did.
+using Percept = std::array<std::uint8_t, 4>;
+
+// What an offer reads and writes of the child. The offers outlive the frame (frame_buffer, next_epoch): `priority`
+// counts only when the epoch is the frame's, so a new frame bumps the epoch instead of clearing 10 MB.
+struct Offer {
+  std::uint32_t epoch = 0;  ///< frame that last wrote `priority`
+  float priority = 0;       ///< highest priority offered so far in frame `epoch`
 };
 
-// This thread's w x h image of P, contents unspecified: the refinement's 22 MB of state (at 1440x900) is
+// This thread's w x h image of P, contents unspecified: the refinement's 17 MB of state (at 1440x900) is
 // reused from frame to frame, as a fresh allocation costs a page fault every 4 KB.
 template <typename P>
 Image<P>& frame_buffer(int w, int h) {
@@ -127,13 +128,13 @@ Image<P>& frame_buffer(int w, int h) {
   return buffer;
 }
 
-// This thread's cells and the epoch of a new frame over them.
-std::uint32_t next_epoch(Image<Cell>& cells) {
-  thread_local const Cell* owner = nullptr;
+// This thread's offers and the epoch of a new frame over them.
+std::uint32_t next_epoch(Image<Offer>& offers) {
+  thread_local const Offer* owner = nullptr;
   thread_local std::uint32_t epoch = 0;
-  if (owner != cells.pixels.data() || ++epoch == 0) {  // new buffer, or the counter wrapped: clear once
-    std::fill(cells.pixels.begin(), cells.pixels.end(), Cell{});
-    owner = cells.pixels.data();
+  if (owner != offers.pixels.data() || ++epoch == 0) {  // new buffer, or the counter wrapped: clear once
+    std::fill(offers.pixels.begin(), offers.pixels.end(), Offer{});
+    owner = offers.pixels.data();
     epoch = 1;
   }
   return epoch;
@@ -144,6 +145,7 @@ struct Ready {
   std::uint32_t pixel;
   int level;
   int known;  ///< parents[0, known)
+  unsigned background;  ///< bit i: parents[i] is background
   std::array<std::uint32_t, 4> parents;
 };
 
@@ -173,20 +175,31 @@ class Refiner {
   Refiner(const ImageF& importance, const FractalPattern& pattern, const RefinementOptions& options,
           std::uint64_t seed, ImageRGBA& image, ImageMask& traced)
       : imp_(importance), pattern_(pattern), options_(options), image_(image), traced_(traced),
-        cells_(frame_buffer<Cell>(importance.width, importance.height)), epoch_(next_epoch(cells_)),
+        percepts_(frame_buffer<Percept>(importance.width, importance.height)),
+        offers_(frame_buffer<Offer>(importance.width, importance.height)), epoch_(next_epoch(offers_)),
         state_(frame_buffer<std::uint8_t>(importance.width, importance.height)), queue_(seed) {
-    // One pass per row of S x S blocks: the state mask and which blocks hold background.
-    const int s = pattern_.base_spacing, bw = (imp_.width + s - 1) / s, bh = (imp_.height + s - 1) / s;
+    // One pass over the S x S blocks, block by block: the state mask and which blocks hold background or object
+    // pixels. Per pixel, only compares and byte stores (a block index per pixel cost a division each).
+    const int s = pattern_.base_spacing, w = imp_.width, h = imp_.height, bw = (w + s - 1) / s, bh = (h + s - 1) / s;
     Image<std::uint8_t> has_background(bw, bh, 0), has_object(bw, bh, 0);
     parallel_rows(bh, [&](int by) {
-      for (int y = by * s; y < std::min(imp_.height, (by + 1) * s); ++y) {
-        const std::size_t row = std::size_t(y) * std::size_t(imp_.width);
-        for (int x = 0; x < imp_.width; ++x) {
-          const std::size_t i = row + std::size_t(x);
-          const bool background = imp_.pixels[i] < 0;
-          state_.pixels[i] = background ? kKnown | kBackground : traced_.pixels[i] ? kKnown : 0;
-          (background ? has_background : has_object)(x / s, by) = 1;
+      for (int bx = 0; bx < bw; ++bx) {
+        std::uint8_t background = 0, object = 0;
+        for (int y = by * s; y < std::min(h, (by + 1) * s); ++y) {
+          // Raw pointers: through the byte stores the compiler would reload every captured reference per pixel.
+          const float* imp = &imp_.pixels[std::size_t(y) * std::size_t(w)];
+          const std::uint8_t* traced = &traced_.pixels[std::size_t(y) * std::size_t(w)];
+          std::uint8_t* state = &state_.pixels[std::size_t(y) * std::size_t(w)];
+          const int x1 = std::min(w, (bx + 1) * s);
+          for (int x = bx * s; x < x1; ++x) {
+            const std::uint8_t is_background = imp[x] < 0 ? 1 : 0;
+            state[x] = is_background ? kKnown | kBackground : traced[x] ? kKnown : 0;
+            background |= is_background;
+            object |= is_background ^ 1;
+          }
         }
+        has_background(bx, by) = background;
+        has_object(bx, by) = object;
       }
     });
     mark_open_blocks(has_background);
@@ -199,23 +212,24 @@ class Refiner {
   // Candidates no traced parent will offer: every in-image parent is background.
   // Their parents lie within S/2, so only open blocks (see mark_open_blocks) with object pixels can hold them.
   void offer_orphans() {
-    push(gather(std::size_t(imp_.height), 16, [this](std::size_t y0, std::size_t y1, std::vector<Candidate>& out) {
+    const int s = pattern_.base_spacing;
+    push(gather(std::size_t(orphan_blocks_.height), 2, [this, s](std::size_t by0, std::size_t by1,
+                                                                 std::vector<Candidate>& out) {
       std::vector<Ready> ready;
-      const int s = pattern_.base_spacing;
-      for (int y = int(y0); y < int(y1); ++y)
-        for (int x = 0; x < imp_.width; ++x) {
-          if (!orphan_blocks_(x / s, y / s)) {
-            x += s - 1 - x % s;  // the rest of this block's row
-            continue;
-          }
-          const int level = pattern_.level(x, y);
-          if (level == 0 || imp_(x, y) < 0) continue;
-          bool orphan = true;
-          for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
-            const int px = x + o[0], py = y + o[1];
-            orphan = orphan && (px < 0 || py < 0 || px >= imp_.width || py >= imp_.height || imp_(px, py) < 0);
-          }
-          if (orphan) list_ready(x, y, level, ready, kNoSource);
+      for (int by = int(by0); by < int(by1); ++by)
+        for (int bx = 0; bx < orphan_blocks_.width; ++bx) {
+          if (!orphan_blocks_(bx, by)) continue;
+          for (int y = by * s; y < std::min(imp_.height, (by + 1) * s); ++y)
+            for (int x = bx * s; x < std::min(imp_.width, (bx + 1) * s); ++x) {
+              const int level = pattern_.level(x, y);
+              if (level == 0 || imp_(x, y) < 0) continue;
+              bool orphan = true;
+              for (const auto& o : parent_offsets(level, s)) {
+                const int px = x + o[0], py = y + o[1];
+                orphan = orphan && (px < 0 || py < 0 || px >= imp_.width || py >= imp_.height || imp_(px, py) < 0);
+              }
+              if (orphan) list_ready(x, y, level, ready, kNoSource);
+            }
         }
       for (const Ready& r : ready) evaluate(r, out);
     }));
@@ -258,8 +272,9 @@ class Refiner {
   void known_mask(ImageMask& out) const {
     out = ImageMask(imp_.width, imp_.height, 0);
     parallel_rows(imp_.height, [&](int y) {
-      const std::size_t row = std::size_t(y) * std::size_t(imp_.width);
-      for (std::size_t i = row; i < row + std::size_t(imp_.width); ++i) out.pixels[i] = state_.pixels[i] & kKnown;
+      std::uint8_t* known = &out.pixels[std::size_t(y) * std::size_t(imp_.width)];
+      const std::uint8_t* state = &state_.pixels[std::size_t(y) * std::size_t(imp_.width)];
+      for (int x = 0; x < out.width; ++x) known[x] = state[x] & kKnown;
     });
   }
 
@@ -269,8 +284,8 @@ class Refiner {
   void record(std::uint32_t pixel) {
     const Rgba& c = image_.pixels[pixel];
     auto code = [](float v) { return std::uint8_t(std::lround(255.0f * std::min(1.0f, std::max(0.0f, v)))); };
-    cells_.pixels[pixel].percept = {code(std::sqrt(std::max(0.0f, c.r))), code(std::sqrt(std::max(0.0f, c.g))),
-                              code(std::sqrt(std::max(0.0f, c.b))), code(c.a)};
+    percepts_.pixels[pixel] = {code(std::sqrt(std::max(0.0f, c.r))), code(std::sqrt(std::max(0.0f, c.g))),
+                               code(std::sqrt(std::max(0.0f, c.b))), code(c.a)};
   }
 
   // open_(bx, by) = 1 where the S x S blocks around block (bx, by) hold background (`has`) or reach past the
@@ -293,7 +308,7 @@ class Refiner {
   void children(std::uint32_t pixel, std::vector<Ready>& ready) const {
     const int w = imp_.width, qx = int(pixel % std::uint32_t(w)), qy = int(pixel / std::uint32_t(w));
     const int lq = fractal_level(qx, qy, pattern_.base_spacing);
-    const bool open = open_(qx / pattern_.base_spacing, qy / pattern_.base_spacing) != 0;
+    const bool open = open_(qx >> block_shift_, qy >> block_shift_) != 0;
     const int end = open ? pattern_.num_levels : std::min(pattern_.num_levels, lq + 3);
     for (int level = lq + 1; level < end; ++level)
       for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
@@ -305,13 +320,13 @@ class Refiner {
 
   // Whether traced pixel (px, py) lists its children of `level` (see children()).
   bool lists(int px, int py, int level) const {
-    const int s = pattern_.base_spacing;
-    return open_(px / s, py / s) != 0 || level < fractal_level(px, py, s) + 3;
+    return open_(px >> block_shift_, py >> block_shift_) != 0 ||
+           level < fractal_level(px, py, pattern_.base_spacing) + 3;
   }
 
   // Appends (x, y) of `level` to `ready` unless it is known, taken or waits for a corner, decided on the small
-  // state_ mask alone (most children asked about wait for a corner), and prefetches the cells its priority
-  // reads: these are scattered, and a chunk's priorities are computed after all its children are listed.
+  // state_ mask alone (most children asked about wait for a corner), and prefetches the percepts and the offer its
+  // priority reads: these are scattered, and a chunk's priorities are computed after all its children are listed.
   // `source` is the traced parent asking (kNoSource: none). A child whose several parents were traced in one round
   // is listed once, by the lowest-index one: the duplicates would get the same priority and push() would drop them.
   // The record is written in place: built on the stack, its narrow stores were reloaded as one wide copy into
@@ -323,28 +338,31 @@ class Refiner {
     r.pixel = std::uint32_t(y) * std::uint32_t(imp_.width) + std::uint32_t(x);
     r.level = level;
     r.known = 0;
+    r.background = 0;
     for (const auto& o : parent_offsets(level, pattern_.base_spacing)) {
       const int px = x + o[0], py = y + o[1];
       if (px < 0 || py < 0 || px >= imp_.width || py >= imp_.height) continue;
       const std::uint32_t parent = std::uint32_t(py) * std::uint32_t(imp_.width) + std::uint32_t(px);
-      if (parent < source && (state_.pixels[parent] & kFresh) && lists(px, py, level)) {
+      const std::uint8_t parent_state = state_.pixels[parent];
+      if (parent < source && (parent_state & kFresh) && lists(px, py, level)) {
         ready.pop_back();  // that parent lists it
         return;
       }
       // Required: the corners of the square cell being split (for an edge midpoint, the edge's two ends).
       // The squares' centres beside an edge midpoint only add contrast: requiring them would let a flat
       // neighbour cell block the refinement of an edge cell.
-      if (!(state_(px, py) & kKnown)) {
+      if (!(parent_state & kKnown)) {
         if ((px & lattice_mask) == 0 && (py & lattice_mask) == 0) {
           ready.pop_back();  // offered again when it is traced
           return;
         }
         continue;
       }
+      r.background |= parent_state & kBackground ? 1u << r.known : 0u;
       r.parents[std::size_t(r.known++)] = parent;
     }
-    for (int i = 0; i < r.known; ++i) __builtin_prefetch(&cells_.pixels[r.parents[std::size_t(i)]]);
-    __builtin_prefetch(&cells_.pixels[r.pixel]);
+    for (int i = 0; i < r.known; ++i) __builtin_prefetch(&percepts_.pixels[r.parents[std::size_t(i)]]);
+    __builtin_prefetch(&offers_.pixels[r.pixel]);
     __builtin_prefetch(&imp_.pixels[r.pixel]);
   }
 
@@ -355,7 +373,7 @@ class Refiner {
     constexpr std::array<std::uint8_t, 4> kBackgroundPercept{};  // its image value (0) as record() codes it
     for (int i = 0; i < r.known; ++i) {
       const std::array<std::uint8_t, 4>& c =
-          state_.pixels[r.parents[i]] & kBackground ? kBackgroundPercept : cells_.pixels[r.parents[i]].percept;
+          (r.background >> i) & 1 ? kBackgroundPercept : percepts_.pixels[r.parents[i]];
       for (int k = 0; k < 4; ++k) {
         lo[k] = std::min(lo[k], int(c[k]));
         hi[k] = std::max(hi[k], int(c[k]));
@@ -366,12 +384,12 @@ class Refiner {
     const float contrast = float(spread) * (1.0f / 255.0f);
     const float priority =
         (contrast + options_.floor + options_.line_weight * imp_.pixels[r.pixel]) * level_share_[r.level];
-    if (priority <= 1.05f * offered(cells_.pixels[r.pixel])) return;  // see push()
+    if (priority <= 1.05f * offered(offers_.pixels[r.pixel])) return;  // see push()
     out.push_back({r.pixel, priority, bucket_of(priority)});
   }
 
   // Lists the candidates of `count` sources with list(source, ready), then evaluates them, a few sources at a
-  // time so the prefetched cells are still cached.
+  // time so what was prefetched is still cached.
   template <typename List>
   void evaluate_all(std::size_t count, const List& list, std::vector<Candidate>& out) const {
     std::vector<Ready> ready;
@@ -385,24 +403,25 @@ class Refiner {
   void push(const std::vector<Candidate>& candidates) {
     for (std::size_t i = 0; i < candidates.size(); ++i) {
       const Candidate& c = candidates[i];
-      if (i + 16 < candidates.size()) __builtin_prefetch(&cells_.pixels[candidates[i + 16].pixel]);
+      if (i + 16 < candidates.size()) __builtin_prefetch(&offers_.pixels[candidates[i + 16].pixel]);
       // Offered again when another parent was traced: only a clearly higher priority is worth a second entry.
-      Cell& cell = cells_.pixels[c.pixel];
-      if (c.priority <= 1.05f * offered(cell)) continue;
+      Offer& offer = offers_.pixels[c.pixel];
+      if (c.priority <= 1.05f * offered(offer)) continue;
       queue_.push(c.bucket, c.pixel);
-      cell.offered = c.priority;
-      cell.epoch = epoch_;
+      offer.priority = c.priority;
+      offer.epoch = epoch_;
     }
   }
 
-  float offered(const Cell& cell) const { return cell.epoch == epoch_ ? cell.offered : 0.0f; }
+  float offered(const Offer& offer) const { return offer.epoch == epoch_ ? offer.priority : 0.0f; }
 
   const ImageF& imp_;
   const FractalPattern& pattern_;
   const RefinementOptions& options_;
   ImageRGBA& image_;
   ImageMask& traced_;
-  Image<Cell>& cells_;
+  Image<Percept>& percepts_;
+  Image<Offer>& offers_;
   std::uint32_t epoch_;
   static constexpr std::uint8_t kKnown = 1, kTaken = 2, kBackground = 4, kFresh = 8;
   static constexpr std::uint32_t kNoSource = 0xFFFFFFFFu;
@@ -410,6 +429,7 @@ class Refiner {
   /// round whose offers are being listed
   ImageMask& state_;
   BucketQueue queue_;
+  const int block_shift_ = __builtin_ctz(unsigned(pattern_.base_spacing));  ///< log2 S: x >> it is x's block column
   Image<std::uint8_t> open_;  ///< per S x S block, see mark_open_blocks()
   Image<std::uint8_t> orphan_blocks_;  ///< open blocks holding an object pixel: where offer_orphans() looks
   std::array<float, 16> level_share_;  ///< 2^-level, the share of the frame one ray of a level covers
