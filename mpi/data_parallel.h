@@ -45,7 +45,7 @@ BrickInput load_brick(const DataParallelPlan& plan, const std::string& path, con
 struct DataParallelFrame {
   ImageRGBA image;              ///< rank 0: composited over options.background; elsewhere empty
   std::uint64_t samples = 0;    ///< summed over ranks
-  std::uint64_t visible_blocks = 0;  ///< summed over ranks (blocks near brick planes count on both sides)
+  std::uint64_t visible_blocks = 0;  ///< summed over ranks: the one-process count (each block is one rank's)
   double render_ms = 0, composite_ms = 0;  ///< this rank's
   double wait_ms = 0;  ///< this rank's wait for the slowest rank between rendering and compositing
 };
