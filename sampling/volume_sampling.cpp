@@ -49,14 +49,18 @@ bool lines_fit_budget(double lines_ms, double budget_ms, double max_share) {
 ImageF frame_importance(const volume::RayCaster& caster, const FeatureGeometry* geometry,
                         const FeatureOptions& options) {
   // The caster's exact background (equal to pixel_is_background at every pixel), then the lines.
-  const Image<std::uint8_t> background = caster.background_mask();
-  ImageF importance(caster.width(), caster.height(), 0.0f);
+  return frame_importance(caster.background_mask(), caster.camera(), geometry, options);
+}
+
+ImageF frame_importance(const Image<std::uint8_t>& background, const Camera& camera, const FeatureGeometry* geometry,
+                        const FeatureOptions& options) {
+  ImageF importance(camera.width(), camera.height(), 0.0f);
   if (geometry != nullptr && !options.classes.is_empty()) {
     features::LineOptions lines = options.lines;
     lines.classes = options.classes;
     // No background geometry: the mask above decides background.
     const features::ImportanceBuffer buffer = features::compute_importance(
-        geometry->mesh, geometry->curvature, caster.camera(), lines, features::BackgroundGeometry{}, options.importance);
+        geometry->mesh, geometry->curvature, camera, lines, features::BackgroundGeometry{}, options.importance);
     importance = features::upsample_importance(buffer, options.importance.threaded);
   }
   parallel_for_each(importance.size(), [&](std::size_t i) {

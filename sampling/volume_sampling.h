@@ -65,6 +65,10 @@ features::LineClassSet parse_feature_list(const std::string& list);
 /// importance sampled at the pixel (0 when `geometry` is null or no class is enabled).
 ImageF frame_importance(const volume::RayCaster& caster, const FeatureGeometry* geometry,
                         const FeatureOptions& options);
+/// Same from a given background mask (1 = background) seen by `camera`: --distribute data all-reduces the
+/// ranks' masks into the one-process mask.
+ImageF frame_importance(const Image<std::uint8_t>& background, const Camera& camera, const FeatureGeometry* geometry,
+                        const FeatureOptions& options);
 
 /// The caster as a batch tracer for the scheduler; adds the volume samples taken to `samples` if given.
 TraceBatch caster_trace_batch(const volume::RayCaster& caster, std::atomic<std::uint64_t>* samples = nullptr);

@@ -219,6 +219,18 @@ TEST_P(DataParallelSampled, PrioritizedControlWithRefinementMatchesTheSingleProc
                  "--shading phong --mode prioritized --features none --ray-fraction 0.25");
 }
 
+TEST_P(DataParallelSampled, PrioritizedLinesFromAFeatureMeshMatchTheSingleProcessFrame) {
+  // A prepared mesh needs no voxel: rank 0 draws its lines over the all-reduced mask, as one process over its own.
+  write_test_volume();
+  const test::CliRun mesh = single(dir_, "mesh v.vdb --tf tf.json -o m.ply --quiet");
+  ASSERT_EQ(mesh.code, 0) << mesh.err;
+  expect_matches("render v.vdb --tf tf.json --camera oblique.json --early-termination 1 --width 64 --height 48 "
+                 "--mode prioritized --ray-fraction 0.25 --feature-mesh m.ply");
+  const Json s = read_json_file(dir_ + "/s.json");
+  EXPECT_EQ(s["features"], "lines");
+  EXPECT_GT(s["feature_triangles"], 0u);
+}
+
 INSTANTIATE_TEST_SUITE_P(BallAndSlab, DataParallelSampled, ::testing::Bool(),
                          [](const ::testing::TestParamInfo<bool>& p) { return p.param ? "Slab" : "Ball"; });
 
@@ -249,6 +261,7 @@ TEST_F(DataParallel, FeatureLinesAreRefusedWithOneUsageMessage) {
   const test::CliRun r = ranks(2, dir_, "render v.vdb --tf tf.json --distribute data --mode prioritized -o out.exr");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--distribute data computes no feature lines"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--feature-mesh"), std::string::npos) << r.err;  // the way that works
   EXPECT_EQ(r.err.find("raysift: error:"), r.err.rfind("raysift: error:")) << r.err;
   EXPECT_FALSE(fs::exists(dir_ + "/out.exr"));
 }
