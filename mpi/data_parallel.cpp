@@ -179,18 +179,7 @@ ImageF shared_importance(const Image<std::uint8_t>& background, const volume::Ra
     summary = sampling::summarize(geometry);
     importance = sampling::frame_importance(background, caster.camera(), &geometry, request.features);
   });
-#if RAYSIFT_HAVE_MPI
-  const Timer timer;
-  MPI_Bcast(importance.pixels.data(), int(importance.pixels.size()), MPI_FLOAT, 0, MPI_COMM_WORLD);
-  stats.composite_ms += timer.elapsed_ms();
-  const std::uint64_t bytes = importance.pixels.size() * sizeof(float);
-  if (is_root())
-    stats.bytes_sent += bytes * std::uint64_t(size() - 1);
-  else
-    stats.bytes_received += bytes;
-#else
-  (void)stats;
-#endif
+  broadcast_importance(importance, stats);
   return importance;
 }
 

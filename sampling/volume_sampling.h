@@ -144,6 +144,11 @@ struct SampledRender {
   bool lines_skipped_for_budget = false;
 };
 
+/// Copies a frame's counts and stage times into `out` (not its image; any_budget_too_small accumulates): the one
+/// rule for every SampledRender, in one process and under MPI.
+void record_frame(SampledRender& out, const SampledFrame& frame, double importance_ms, double frame_ms,
+                  std::uint64_t samples);
+
 /// True when volume::select_iso_values would find no surface (the TF hides every value the volume holds):
 /// render_sampled_volume then renders without feature lines.
 bool transparent_over_data(const volume::Volume& volume, const volume::TransferFunction& tf);
