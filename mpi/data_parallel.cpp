@@ -2,6 +2,7 @@
 
 #include <limits>
 #include <memory>
+#include <optional>
 
 #include "core/errors.h"
 #include "core/timer.h"
@@ -137,10 +138,10 @@ DataParallelFrame render_data_parallel(const DataParallelPlan& plan, const volum
 
 namespace {
 
-/// The control importance on every rank: -1 where the pixel is background for every brick, else 0. Each brick
-/// caster's mask is exact for its segment (a background pixel's segment is transparent black), so a pixel all
-/// masks call background traces to transparent black: skipping it keeps a ray fraction of 1 exact.
-ImageF shared_background_importance(const volume::RayCaster& caster, RankStats& stats) {
+/// The background mask on every rank: a pixel is background iff every brick caster says so (an AND of the
+/// masks). Each caster tests the blocks it owns of the whole grid's table and every such block is one rank's, so
+/// the AND is the one-process caster's mask (docs/distributed.md, "Is the OR-mask the caster's exact test?").
+Image<std::uint8_t> shared_background(const volume::RayCaster& caster, RankStats& stats) {
   Image<std::uint8_t> background = caster.background_mask();
 #if RAYSIFT_HAVE_MPI
   if (size() > 1) {
@@ -154,8 +155,31 @@ ImageF shared_background_importance(const volume::RayCaster& caster, RankStats& 
 #else
   (void)stats;
 #endif
-  ImageF importance(caster.width(), caster.height(), 0.0f);
-  for (std::size_t i = 0; i < importance.pixels.size(); ++i) importance.pixels[i] = background.pixels[i] ? -1.0f : 0.0f;
+  return background;
+}
+
+/// Prioritized with line classes and a ray fraction (budget frames keep the control, as one process does by
+/// default: max_budget_share = 0).
+bool wants_lines(const sampling::SampledRenderRequest& request) {
+  return request.sampling.mode == sampling::SamplingMode::Prioritized && !request.features.classes.is_empty() &&
+         request.sampling.budget_ms <= 0;
+}
+
+/// The frame's importance on every rank. Without lines: the control from the shared mask, computed on every
+/// rank. With lines (a --feature-mesh: they need no voxel): rank 0 loads the mesh, rasterises its lines over the
+/// shared mask and broadcasts the importance, as --distribute image does; `summary` gets the mesh's on rank 0.
+ImageF shared_importance(const Image<std::uint8_t>& background, const volume::RayCaster& caster,
+                         const sampling::SampledRenderRequest& request,
+                         std::optional<sampling::FeatureGeometrySummary>& summary, RankStats& stats) {
+  if (!wants_lines(request)) return sampling::frame_importance(background, caster.camera(), nullptr, request.features);
+  ImageF importance(caster.width(), caster.height());
+  all_or_none([&] {
+    if (!is_root()) return;
+    const sampling::FeatureGeometry geometry = isosurface::load_feature_geometry(request.feature_mesh);
+    summary = sampling::summarize(geometry);
+    importance = sampling::frame_importance(background, caster.camera(), &geometry, request.features);
+  });
+  broadcast_importance(importance, stats);
   return importance;
 }
 
@@ -170,19 +194,21 @@ DataSampledFrame render_sampled_data_parallel(const DataParallelPlan& plan, cons
   all_or_none([&] {  // the same checks on every rank, before the first collective
     if (request.progressive_frames != 0)
       throw UsageError("--distribute data renders single frames; --progressive is not distributed");
-    // Lines need one mesh of the whole volume; a rank holds one brick. Budget frames use the control anyway.
-    if (request.sampling.mode == sampling::SamplingMode::Prioritized && !request.features.classes.is_empty() &&
-        request.sampling.budget_ms <= 0)
-      throw UsageError("--distribute data computes no feature lines (each rank holds one brick): pass "
-                       "--features none for the control importance, or use --distribute image");
+    // Lines from the volume need its iso-surfaces; a rank holds one brick. A prepared mesh needs no voxel.
+    if (wants_lines(request) && request.feature_mesh.empty())
+      throw UsageError("--distribute data computes no feature lines from the volume (each rank holds one brick): "
+                       "pass --feature-mesh (e.g. from raysift mesh), --features none for the control importance, "
+                       "or use --distribute image");
     sampling::validate(request.sampling);
     caster = std::make_unique<volume::RayCaster>(brick, tf, camera, segment_options(plan, options));
   });
   const Timer total;
-  const ImageF importance = shared_background_importance(*caster, stats);
+  std::optional<sampling::FeatureGeometrySummary> summary;
+  const ImageF importance = shared_importance(shared_background(*caster, stats), *caster, request, summary, stats);
   const std::vector<int> order = visibility_order(plan.split, brick.world_to_index(camera.eye));
   DataSampledFrame frame;
   frame.render = render_sampled_lockstep(importance, total, *caster, request.sampling, background, order, stats);
+  frame.render.features = std::move(summary);
   frame.visible_blocks = std::uint64_t(sum_all(double(caster->visible_block_count())));
   return frame;
 }

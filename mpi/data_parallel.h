@@ -45,7 +45,7 @@ BrickInput load_brick(const DataParallelPlan& plan, const std::string& path, con
 struct DataParallelFrame {
   ImageRGBA image;              ///< rank 0: composited over options.background; elsewhere empty
   std::uint64_t samples = 0;    ///< summed over ranks
-  std::uint64_t visible_blocks = 0;  ///< summed over ranks (blocks near brick planes count on both sides)
+  std::uint64_t visible_blocks = 0;  ///< summed over ranks: the one-process count (each block is one rank's)
   double render_ms = 0, composite_ms = 0;  ///< this rank's
   double wait_ms = 0;  ///< this rank's wait for the slowest rank between rendering and compositing
 };
@@ -59,10 +59,12 @@ DataParallelFrame render_data_parallel(const DataParallelPlan& plan, const volum
 
 /// \brief Collective: a prioritized or subsample frame in the image mode's lock step (mpi/image_parallel.h), each
 /// set of rays traced as segments on every rank and composited in the k-d visibility order on every rank. The
-/// importance is the control (background -1, else 0), computed identically on every rank: a pixel is
-/// background iff every rank's brick caster says so (an all-reduce of the masks). Rank 0 gets the image.
-/// \throw (as RankFailure on every rank) UsageError for feature lines (prioritized with --features and a ray
-/// fraction) or progressive frames.
+/// background mask is computed identically on every rank: a pixel is background iff every rank's brick caster
+/// says so (an all-reduce of the masks, equal to the one-process mask). The importance is the control (background
+/// -1, else 0), or with feature lines from `request.feature_mesh` rank 0's lines over that mask, broadcast.
+/// Rank 0 gets the image.
+/// \throw (as RankFailure on every rank) UsageError for feature lines without a feature mesh (prioritized with
+/// --features and a ray fraction) or progressive frames.
 struct DataSampledFrame {
   sampling::SampledRender render;    ///< rank 0: image, counts and stage times; elsewhere no image
   std::uint64_t visible_blocks = 0;  ///< summed over ranks, as DataParallelFrame's

@@ -340,14 +340,7 @@ ImageF shared_importance(const volume::Volume& volume, const volume::TransferFun
     out.features = sampling::summarize(geometry);
     importance = sampling::frame_importance(caster, &geometry, request.features);
   });
-  const Timer timer;
-  MPI_Bcast(importance.pixels.data(), int(importance.pixels.size()), MPI_FLOAT, 0, MPI_COMM_WORLD);
-  stats.composite_ms += timer.elapsed_ms();
-  const std::uint64_t bytes = importance.pixels.size() * sizeof(float);
-  if (is_root())
-    stats.bytes_sent += bytes * std::uint64_t(size() - 1);
-  else
-    stats.bytes_received += bytes;
+  broadcast_importance(importance, stats);
   return importance;
 }
 
@@ -401,6 +394,21 @@ sampling::SampledRender render_sampled_image_parallel(const volume::Volume& volu
 #endif
 }
 
+void broadcast_importance(ImageF& importance, RankStats& stats) {
+#if RAYSIFT_HAVE_MPI
+  const Timer timer;
+  MPI_Bcast(importance.pixels.data(), int(importance.pixels.size()), MPI_FLOAT, 0, MPI_COMM_WORLD);
+  stats.composite_ms += timer.elapsed_ms();
+  const std::uint64_t bytes = importance.pixels.size() * sizeof(float);
+  if (is_root())
+    stats.bytes_sent += bytes * std::uint64_t(size() - 1);
+  else
+    stats.bytes_received += bytes;
+#else
+  (void)importance, (void)stats;
+#endif
+}
+
 sampling::SampledRender render_sampled_lockstep(const ImageF& importance, const Timer& total,
                                                 const volume::RayCaster& caster,
                                                 const sampling::SamplingOptions& sampling, const Vec3f& background,
@@ -427,15 +435,7 @@ sampling::SampledRender render_sampled_lockstep(const ImageF& importance, const 
   out.samples = sum_on_root(tracer.samples);
   if (!is_root()) return out;
   out.image = sampling::composite_frame(frame.image, background);
-  out.rays_traced = frame.rays_traced;
-  out.full_rays = frame.full_rays;
-  out.level0_rays = frame.level0_rays;
-  out.importance_ms = importance_ms;
-  out.priorities_ms = frame.priorities_ms;
-  out.trace_ms = frame.trace_ms;
-  out.reconstruct_ms = frame.reconstruct_ms;
-  out.frame_ms = total.elapsed_ms();
-  out.budget_too_small = out.any_budget_too_small = frame.budget_too_small;
+  sampling::record_frame(out, frame, importance_ms, total.elapsed_ms(), out.samples);
   return out;
 #else
   (void)importance, (void)total, (void)caster, (void)sampling, (void)background, (void)segment_order, (void)stats;

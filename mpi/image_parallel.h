@@ -32,6 +32,10 @@ sampling::SampledRender render_sampled_image_parallel(const volume::Volume& volu
                                                       const volume::RayCaster& caster,
                                                       const sampling::SampledRenderRequest& request, RankStats& stats);
 
+/// Collective: rank 0's `importance` on every rank (w·h floats); the time goes to composite_ms, the bytes to the
+/// traffic in `stats`.
+void broadcast_importance(ImageF& importance, RankStats& stats);
+
 /// \brief Collective: the lock step above with a given `importance` (every rank's equal) and `total` started
 /// before it was computed. Rank 0 gets the frame composited over `background`. `segment_order` empty: image
 /// mode (rays dealt over the ranks). Otherwise --distribute data (mpi/data_parallel.h): `caster` renders this

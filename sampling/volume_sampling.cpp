@@ -49,14 +49,18 @@ bool lines_fit_budget(double lines_ms, double budget_ms, double max_share) {
 ImageF frame_importance(const volume::RayCaster& caster, const FeatureGeometry* geometry,
                         const FeatureOptions& options) {
   // The caster's exact background (equal to pixel_is_background at every pixel), then the lines.
-  const Image<std::uint8_t> background = caster.background_mask();
-  ImageF importance(caster.width(), caster.height(), 0.0f);
+  return frame_importance(caster.background_mask(), caster.camera(), geometry, options);
+}
+
+ImageF frame_importance(const Image<std::uint8_t>& background, const Camera& camera, const FeatureGeometry* geometry,
+                        const FeatureOptions& options) {
+  ImageF importance(camera.width(), camera.height(), 0.0f);
   if (geometry != nullptr && !options.classes.is_empty()) {
     features::LineOptions lines = options.lines;
     lines.classes = options.classes;
     // No background geometry: the mask above decides background.
     const features::ImportanceBuffer buffer = features::compute_importance(
-        geometry->mesh, geometry->curvature, caster.camera(), lines, features::BackgroundGeometry{}, options.importance);
+        geometry->mesh, geometry->curvature, camera, lines, features::BackgroundGeometry{}, options.importance);
     importance = features::upsample_importance(buffer, options.importance.threaded);
   }
   parallel_for_each(importance.size(), [&](std::size_t i) {
@@ -121,6 +125,21 @@ VolumeFrame render_volume_frame(const volume::RayCaster& caster, const FeatureGe
   return frame;
 }
 
+void record_frame(SampledRender& out, const SampledFrame& frame, double importance_ms, double frame_ms,
+                  std::uint64_t samples) {
+  out.rays_traced = frame.rays_traced;
+  out.samples = samples;
+  out.full_rays = frame.full_rays;
+  out.level0_rays = frame.level0_rays;
+  out.importance_ms = importance_ms;
+  out.priorities_ms = frame.priorities_ms;
+  out.trace_ms = frame.trace_ms;
+  out.reconstruct_ms = frame.reconstruct_ms;
+  out.frame_ms = frame_ms;
+  out.budget_too_small = frame.budget_too_small;
+  out.any_budget_too_small = out.any_budget_too_small || frame.budget_too_small;
+}
+
 SampledRender render_sampled_volume(const volume::Volume& volume, const volume::TransferFunction& tf,
                                     const volume::RayCaster& caster, const SampledRenderRequest& request) {
   validate(request.sampling);
@@ -140,23 +159,9 @@ SampledRender render_sampled_volume(const volume::Volume& volume, const volume::
   out.features_skipped = skip_features;
   out.mode = request.sampling.mode;
   if (uses_features) out.features = summarize(geometry);
-  auto fill = [&](const SampledFrame& f, double importance_ms, double total_ms, std::uint64_t samples) {
-    out.rays_traced = f.rays_traced;
-    out.samples = samples;
-    out.full_rays = f.full_rays;
-    out.level0_rays = f.level0_rays;
-    out.importance_ms = importance_ms;
-    out.priorities_ms = f.priorities_ms;
-    out.trace_ms = f.trace_ms;
-    out.reconstruct_ms = f.reconstruct_ms;
-    out.frame_ms = total_ms;
-    out.budget_too_small = f.budget_too_small;
-    out.any_budget_too_small = out.any_budget_too_small || f.budget_too_small;
-  };
-
   if (request.progressive_frames == 0) {
     VolumeFrame frame = render_volume_frame(caster, geometry_ptr, request.features, request.sampling);
-    fill(frame.sampled, frame.importance_ms, frame.total_ms, frame.samples);
+    record_frame(out, frame.sampled, frame.importance_ms, frame.total_ms, frame.samples);
     out.lines_skipped_for_budget = frame.lines_skipped;
     out.image = std::move(frame.image);
     return out;
@@ -173,7 +178,7 @@ SampledRender render_sampled_volume(const volume::Volume& volume, const volume::
     frame = sampler.next_frame(caster_trace_batch(caster, &samples));
     const double ms = timer.elapsed_ms() + (k == 0 ? importance_ms : 0.0);
     out.progressive.push_back({frame.rays_traced, ms, frame.budget_too_small});
-    fill(frame, k == 0 ? importance_ms : 0.0, ms, samples.load());
+    record_frame(out, frame, k == 0 ? importance_ms : 0.0, ms, samples.load());
   }
   out.image = composite_frame(frame.image, caster.options().background);
   return out;

@@ -65,6 +65,10 @@ features::LineClassSet parse_feature_list(const std::string& list);
 /// importance sampled at the pixel (0 when `geometry` is null or no class is enabled).
 ImageF frame_importance(const volume::RayCaster& caster, const FeatureGeometry* geometry,
                         const FeatureOptions& options);
+/// Same from a given background mask (1 = background) seen by `camera`: --distribute data all-reduces the
+/// ranks' masks into the one-process mask.
+ImageF frame_importance(const Image<std::uint8_t>& background, const Camera& camera, const FeatureGeometry* geometry,
+                        const FeatureOptions& options);
 
 /// The caster as a batch tracer for the scheduler; adds the volume samples taken to `samples` if given.
 TraceBatch caster_trace_batch(const volume::RayCaster& caster, std::atomic<std::uint64_t>* samples = nullptr);
@@ -139,6 +143,11 @@ struct SampledRender {
   /// The budget was too small for the lines' predicted cost: the frame used the control importance.
   bool lines_skipped_for_budget = false;
 };
+
+/// Copies a frame's counts and stage times into `out` (not its image; any_budget_too_small accumulates): the one
+/// rule for every SampledRender, in one process and under MPI.
+void record_frame(SampledRender& out, const SampledFrame& frame, double importance_ms, double frame_ms,
+                  std::uint64_t samples);
 
 /// True when volume::select_iso_values would find no surface (the TF hides every value the volume holds):
 /// render_sampled_volume then renders without feature lines.

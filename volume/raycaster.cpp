@@ -146,6 +146,16 @@ struct RayCaster::Impl {
     return nonzero_prefix[last + 1] > nonzero_prefix[first];
   }
 
+  /// Could block `b` (block coordinates) hold a sample of this caster's segment? A block across a brick plane
+  /// holds only ghosts here: its owner's caster sees all of its voxels and decides its visibility.
+  bool block_meets_clip(const Vec3i& b) const {
+    const SegmentClip& clip = options.clip;
+    if (!clip.enabled) return true;
+    for (int a = 0; a < 3; ++a)
+      if (!(double((b[a] + 1) * kBlockSize) > clip.lo[a] && double(b[a] * kBlockSize) < clip.hi[a])) return false;
+    return true;
+  }
+
   /// Ray parameter where the ray leaves block (bx,by,bz).
   static double block_exit(const Vec3d& o, const Vec3d& inv_d, int bx, int by, int bz) {
     const int b[3] = {bx, by, bz};
@@ -554,6 +564,19 @@ std::shared_ptr<const VolumeBricks> build_volume_bricks(const Volume& volume) {
   return std::make_shared<const VolumeBricks>(build_volume_bricks_from_grid(*volume.impl().grid));
 }
 
+std::shared_ptr<const VolumeBricks> build_volume_bricks(const Volume& volume, const SegmentClip& clip) {
+  if (!clip.enabled) return build_volume_bricks(volume);
+  // The whole grid's cells [lattice_min - 1, lattice_max + 1] that the clip owns, plus one cell on each side
+  // for Phong's central differences at p ± 1 (doubles first: the clip is ±infinity on the outside).
+  Vec3i lo, hi;
+  for (int a = 0; a < 3; ++a) {
+    const double first = clip.lattice_min[a] - 1.0, last = clip.lattice_max[a] + 1.0;
+    lo[a] = int(std::clamp(std::floor(clip.lo[a]) - 1.0, first, last + 1.0));
+    hi[a] = int(std::clamp(std::ceil(clip.hi[a]), first - 1.0, last));
+  }
+  return std::make_shared<const VolumeBricks>(build_volume_bricks_from_grid(*volume.impl().grid, lo, hi));
+}
+
 RayCaster::RayCaster(const Volume& volume, const TransferFunction& tf, const CameraSpec& camera,
                      const RenderOptions& options)
     : RayCaster(volume, nullptr, tf, camera, options) {}
@@ -565,7 +588,7 @@ RayCaster::RayCaster(const Volume& volume, std::shared_ptr<const VolumeBricks> b
   const openvdb::math::Transform& xform = grid.transform();
   if (!xform.isLinear())
     throw InvalidInput("volume '" + grid.getName() + "': the ray caster needs a linear index-to-world transform");
-  impl_ = std::make_unique<Impl>(bricks ? std::move(bricks) : build_volume_bricks(volume), camera, options);
+  impl_ = std::make_unique<Impl>(bricks ? std::move(bricks) : build_volume_bricks(volume, options.clip), camera, options);
   Impl& m = *impl_;
   const openvdb::Vec3d eye_ws(camera.eye.x, camera.eye.y, camera.eye.z);
   const openvdb::Vec3d eye = xform.worldToIndex(eye_ws);
@@ -608,7 +631,7 @@ RayCaster::RayCaster(const Volume& volume, std::shared_ptr<const VolumeBricks> b
     for (int j = 0; j < vb.dims.y; ++j)
       for (int i = 0; i < vb.dims.x; ++i) {
         const std::size_t idx = (std::size_t(k) * vb.dims.y + j) * vb.dims.x + i;
-        const bool visible = m.range_visible(vb.lo[idx], vb.hi[idx]);
+        const bool visible = m.range_visible(vb.lo[idx], vb.hi[idx]) && m.block_meets_clip(Vec3i{i, j, k} + vb.block_min);
         m.block_visible[idx] = visible ? 1 : 0;
         if (!visible) continue;
         ++m.visible_blocks;

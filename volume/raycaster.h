@@ -91,6 +91,11 @@ struct VolumeBricks;
 /// Builds the bricks once so that several RayCasters (new TF, new camera) can share them.
 /// Memory: 2.9 KB per 8³ block whose trilinear support is not constant.
 std::shared_ptr<const VolumeBricks> build_volume_bricks(const Volume& volume);
+/// For a clipped caster (a brick of a larger grid): the block table the whole grid has over the cells the clip
+/// owns (and one more on each side, for gradients), so that its blocks, value ranges and hence its visibility
+/// and background test are the whole grid's there. \pre `volume` holds the whole grid's voxels of those blocks
+/// and their apron (mpi's bricks: 2 ghost layers, planes on 8³ block boundaries).
+std::shared_ptr<const VolumeBricks> build_volume_bricks(const Volume& volume, const SegmentClip& clip);
 
 /// \warning Thread-safe for concurrent trace calls (no per-thread state: samples read the immutable
 /// bricks). Not copyable. Construction costs one pass over the tree's leaves unless bricks are passed in.

@@ -69,7 +69,8 @@ class DataParallel : public ::testing::Test {
                     Json::parse(R"({"eye": [-40, 120, -70], "target": [24, 24, 24], "up": [0, 1, 0], "fov_y_deg": 40})"));
   }
   /// Renders `args` in one process and under -np 2 and 3; every distributed image within 1e-5 per channel.
-  /// The same rays traced, too (a sampled mode's choice depends on the traced colours).
+  /// The same rays traced, too (a sampled mode's choice depends on the traced colours), and the same samples and
+  /// visible blocks: each rank's caster owns its blocks of the whole grid's table and takes their samples.
   void expect_matches(const std::string& args) {
     const test::CliRun one = single(dir_, args + " -o one.exr --stats one.json");
     ASSERT_EQ(one.code, 0) << one.err;
@@ -84,6 +85,8 @@ class DataParallel : public ::testing::Test {
       EXPECT_EQ(s["ranks"].size(), std::size_t(n));
       EXPECT_EQ(s["distribute"], "data");
       EXPECT_EQ(s["rays_traced"], one_stats["rays_traced"]) << n << " ranks";
+      EXPECT_EQ(s["samples"], one_stats["samples"]) << n << " ranks";
+      EXPECT_EQ(s["visible_blocks"], one_stats["visible_blocks"]) << n << " ranks";
     }
   }
   std::string dir_;
@@ -99,6 +102,14 @@ TEST_F(DataParallel, SlabCrossingTheBrickPlanesMatchesFromAnObliqueCamera) {
   write_volume(dir_ + "/v.vdb", 48, slab);
   expect_matches("render v.vdb --tf tf.json --camera oblique.json --early-termination 1 --width 64 --height 48 "
                  "--shading phong --step 0.37");
+}
+
+TEST_F(DataParallel, SlabMatchesWithATransferFunctionOpaqueAtTheBackground) {
+  // Opacity at value 0: the whole grid's block table (its active bbox plus one cell) glows. A rank whose own
+  // active bbox is smaller (the tilted slab) used to end its table there and lose those samples.
+  write_json_file(dir_ + "/tf.json", Json::parse(R"({"points": [[0,0.3,0.3,0.3,0.01],[0.3,1,0.5,0.2,0.08],[1,0.2,0.6,1,0.3]]})"));
+  write_volume(dir_ + "/v.vdb", 48, slab);
+  expect_matches("render v.vdb --tf tf.json --camera oblique.json --early-termination 1 --width 64 --height 48");
 }
 
 TEST_F(DataParallel, RandomSparseVolumeMatchesWithJitter) {
@@ -184,21 +195,44 @@ TEST_F(DataParallel, TruncatedFileFailsEveryRankWithOneMessageAndNoOutput) {
 }
 
 // Sampled modes: the lock step on brick segments (docs/distributed.md "Sampled frames"). From the oblique camera
-// each sampled ray through the ball is composited from several ranks' segments, in a brick order unlike the rank
-// order. (The tilted slab is not used here: its masks differ, see the docs.)
-TEST_F(DataParallel, SubsampleMatchesTheSingleProcessFrameAndItsRays) {
-  const test::CliRun make = single(dir_, "make-volume ball --dims 48,48,48 --radius 18 --quiet -o v.vdb");
-  ASSERT_EQ(make.code, 0) << make.err;
+// each sampled ray through the ball or the tilted slab is composited from several ranks' segments, in a brick
+// order unlike the rank order. On the slab the ranks' own active bboxes are smaller than the whole grid's: the
+// all-reduced background mask, and so every priority, must still be the one-process one.
+class DataParallelSampled : public DataParallel, public ::testing::WithParamInterface<bool> {
+ protected:
+  void write_test_volume() {
+    if (GetParam()) return write_volume(dir_ + "/v.vdb", 48, slab);
+    const test::CliRun make = single(dir_, "make-volume ball --dims 48,48,48 --radius 18 --quiet -o v.vdb");
+    ASSERT_EQ(make.code, 0) << make.err;
+  }
+};
+
+TEST_P(DataParallelSampled, SubsampleMatchesTheSingleProcessFrameAndItsRays) {
+  write_test_volume();
   expect_matches("render v.vdb --tf tf.json --camera oblique.json --early-termination 1 --width 64 --height 48 "
                  "--mode subsample --ray-fraction 0.3");
 }
 
-TEST_F(DataParallel, PrioritizedControlWithRefinementMatchesTheSingleProcessFrameAndItsRays) {
-  const test::CliRun make = single(dir_, "make-volume ball --dims 48,48,48 --radius 18 --quiet -o v.vdb");
-  ASSERT_EQ(make.code, 0) << make.err;
+TEST_P(DataParallelSampled, PrioritizedControlWithRefinementMatchesTheSingleProcessFrameAndItsRays) {
+  write_test_volume();
   expect_matches("render v.vdb --tf tf.json --camera oblique.json --early-termination 1 --width 64 --height 48 "
                  "--shading phong --mode prioritized --features none --ray-fraction 0.25");
 }
+
+TEST_P(DataParallelSampled, PrioritizedLinesFromAFeatureMeshMatchTheSingleProcessFrame) {
+  // A prepared mesh needs no voxel: rank 0 draws its lines over the all-reduced mask, as one process over its own.
+  write_test_volume();
+  const test::CliRun mesh = single(dir_, "mesh v.vdb --tf tf.json -o m.ply --quiet");
+  ASSERT_EQ(mesh.code, 0) << mesh.err;
+  expect_matches("render v.vdb --tf tf.json --camera oblique.json --early-termination 1 --width 64 --height 48 "
+                 "--mode prioritized --ray-fraction 0.25 --feature-mesh m.ply");
+  const Json s = read_json_file(dir_ + "/s.json");
+  EXPECT_EQ(s["features"], "lines");
+  EXPECT_GT(s["feature_triangles"], 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(BallAndSlab, DataParallelSampled, ::testing::Bool(),
+                         [](const ::testing::TestParamInfo<bool>& p) { return p.param ? "Slab" : "Ball"; });
 
 TEST_F(DataParallel, PrioritizedControlSkipsExactlyTheOneProcessBackground) {
   // A small ball in a wide frame: most pixels are background, and the all-reduced mask must mark the same ones
@@ -227,6 +261,7 @@ TEST_F(DataParallel, FeatureLinesAreRefusedWithOneUsageMessage) {
   const test::CliRun r = ranks(2, dir_, "render v.vdb --tf tf.json --distribute data --mode prioritized -o out.exr");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--distribute data computes no feature lines"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--feature-mesh"), std::string::npos) << r.err;  // the way that works
   EXPECT_EQ(r.err.find("raysift: error:"), r.err.rfind("raysift: error:")) << r.err;
   EXPECT_FALSE(fs::exists(dir_ + "/out.exr"));
 }

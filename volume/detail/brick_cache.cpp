@@ -39,18 +39,26 @@ void fill_brick(Accessor& acc, const openvdb::Coord& origin, float* dst, const A
 }  // namespace
 
 VolumeBricks build_volume_bricks_from_grid(const openvdb::FloatGrid& grid) {
+  openvdb::CoordBBox bbox;
+  if (!grid.tree().evalActiveVoxelBoundingBox(bbox)) {
+    VolumeBricks out;
+    out.background = grid.background();
+    return out;
+  }
+  const Vec3i lo{bbox.min().x(), bbox.min().y(), bbox.min().z()}, hi{bbox.max().x(), bbox.max().y(), bbox.max().z()};
+  return build_volume_bricks_from_grid(grid, lo - Vec3i{1, 1, 1}, hi + Vec3i{1, 1, 1});
+}
+
+VolumeBricks build_volume_bricks_from_grid(const openvdb::FloatGrid& grid, const Vec3i& cell_lo, const Vec3i& cell_hi) {
   using Tree = openvdb::FloatTree;
   VolumeBricks out;
   out.background = grid.background();
-  openvdb::CoordBBox bbox;
-  if (!grid.tree().evalActiveVoxelBoundingBox(bbox)) return out;
+  if (cell_lo.x > cell_hi.x || cell_lo.y > cell_hi.y || cell_lo.z > cell_hi.z) return out;
   out.is_empty = false;
-  out.index_min = {bbox.min().x(), bbox.min().y(), bbox.min().z()};
-  out.index_max = {bbox.max().x(), bbox.max().y(), bbox.max().z()};
-  const Vec3i bmin{floor_div_block(out.index_min.x - 1), floor_div_block(out.index_min.y - 1),
-                   floor_div_block(out.index_min.z - 1)};
-  const Vec3i bmax{floor_div_block(out.index_max.x + 1), floor_div_block(out.index_max.y + 1),
-                   floor_div_block(out.index_max.z + 1)};
+  out.index_min = cell_lo + Vec3i{1, 1, 1};
+  out.index_max = cell_hi - Vec3i{1, 1, 1};
+  const Vec3i bmin{floor_div_block(cell_lo.x), floor_div_block(cell_lo.y), floor_div_block(cell_lo.z)};
+  const Vec3i bmax{floor_div_block(cell_hi.x), floor_div_block(cell_hi.y), floor_div_block(cell_hi.z)};
   out.block_min = bmin;
   out.dims = bmax - bmin + Vec3i{1, 1, 1};
   const std::size_t count = std::size_t(out.dims.x) * out.dims.y * out.dims.z;

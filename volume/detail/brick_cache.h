@@ -32,7 +32,7 @@ struct Cell {
 
 struct VolumeBricks {
   bool is_empty = true;
-  Vec3i index_min, index_max;  ///< active voxel bbox (inclusive), index space
+  Vec3i index_min, index_max;  ///< active voxel bbox (inclusive), index space (or the given table's, see below)
   Vec3i block_min;             ///< first block coordinate (block = floor(voxel / 8))
   Vec3i dims;                  ///< blocks per axis; they cover the cells [index_min - 1, index_max + 1]
   float background = 0;
@@ -72,5 +72,9 @@ struct VolumeBricks {
 
 /// Parallel over z-slabs of blocks; deterministic. Memory: 9³ floats per non-constant block.
 VolumeBricks build_volume_bricks_from_grid(const openvdb::FloatGrid& grid);
+/// Same over the blocks of the inclusive cell box [cell_lo, cell_hi] instead of the active bbox ± 1 (index_min/max
+/// become cell_lo + 1 and cell_hi - 1; an empty box gives an empty table). A brick of a larger grid gets the
+/// block table the whole grid has there, even where the brick itself holds no active voxel.
+VolumeBricks build_volume_bricks_from_grid(const openvdb::FloatGrid& grid, const Vec3i& cell_lo, const Vec3i& cell_hi);
 
 }  // namespace raysift::volume
