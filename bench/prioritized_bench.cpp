@@ -6,12 +6,15 @@
 //    in the full render). Prioritized twice: with today's importance cost, and with the importance charged at
 //    5% of the full frame (issue 13 item 2's target; the rays and reconstruction are the real ones);
 //  * the equal-ray ratios at fractions 0.1/0.2/0.4 as a secondary view;
-//  * budget mode p95 / budget on the engine CT.
+//  * budget mode p95 / budget on the engine CT;
+//  * the orbit figures (issue 13 item 5): a 60-frame orbit from each scene's view at a target of 3x the full-render
+//    rate through the camera-path renderer of `raysift render --camera-path --target-fps`, its p95 frame time /
+//    target and each frame's SSIM_object and FLIP_object against the full render of that frame.
 // Scenes: engine CT opaque and translucent (second view), MRI head opaque and translucent, and with --unseen
 // the smoke VDB from the shared datasets (bench/bench_data.h) with a TF written once (normalised to its value range) and never tuned.
 // Usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--linear] [--floor F] [--line-weight W]
 //                          [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N] [--budget-only]
-//                          [--spacing S] [--max-budget-share K]
+//                          [--spacing S] [--max-budget-share K] [--orbit-only] [--orbit-frames N]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -24,6 +27,7 @@
 #include "bench/bench_data.h"
 #include "core/json_io.h"
 #include "core/timer.h"
+#include "sampling/camera_path.h"
 #include "sampling/trade.h"
 #include "volume/transfer_function.h"
 #include "volume/vdb_io.h"
@@ -115,6 +119,8 @@ struct Setup {
   int budget_frames = 10;
   int overhead_only = 0;  ///< > 0: only the overhead table, repeated this many times (for a profiler)
   bool budget_only = false;  ///< only the budget table (engine opaque)
+  int orbit_frames = 60;     ///< frames of each scene's orbit; 0 = no orbit
+  bool orbit_only = false;   ///< only the orbit figures
 };
 
 struct Scene {
@@ -140,9 +146,34 @@ void print_ratio_row(const char* what, double share, const TimedError& m, const 
               m.error.dssim_linear / sub.dssim_linear, m.rays, m.trace_ms, m.reconstruct_ms);
 }
 
+// One orbit's line: frame times against the target, and each frame's error against its full render.
+void print_orbit(const std::vector<sampling::PathFrame>& frames, const std::vector<Error>& errors, double target_fps,
+                 double full_ms) {
+  std::vector<double> times;
+  double rays = 0, ssim = 0, ssim_linear = 0, flip = 0, worst_ssim = 1;
+  int lines_skipped = 0;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    times.push_back(frames[i].ms);
+    rays += double(frames[i].rays_traced) / double(std::max<std::size_t>(1, frames[i].full_rays));
+    lines_skipped += frames[i].lines_skipped;
+    ssim += 1 - errors[i].dssim;
+    ssim_linear += 1 - errors[i].dssim_linear;
+    flip += errors[i].flip;
+    worst_ssim = std::min(worst_ssim, 1 - errors[i].dssim);
+  }
+  const double n = double(frames.size()), target_ms = 1000.0 / target_fps, p95 = percentile(times, 0.95);
+  std::printf("orbit (%zu frames, target 3x the full rate = %.0f ms; full frame just before %.0f ms): p50 %.0f ms, "
+              "p95 %.0f ms, p95/target %.3f, within 1.1x target %.0f%%; SSIM_obj mean %.4f (min %.4f), "
+              "SSIMlin_obj mean %.4f, FLIP_obj mean %.4f; mean ray fraction %.3f; lines skipped in %d frames\n",
+              frames.size(), target_ms, full_ms, percentile(times, 0.5), p95, p95 / target_ms,
+              100 * sampling::summarize_path(frames, target_fps).within_10pct_of_target, ssim / n, worst_ssim,
+              ssim_linear / n, flip / n, rays / n, lines_skipped);
+}
+
 // One scene's view with its full render and importance buffers; each table is one member function.
 struct SceneRun {
   const Setup& setup;
+  const Scene& scene;
   volume::RayCaster caster;
   sampling::FeatureGeometry geometry;
   ImageRGBA full;
@@ -151,7 +182,7 @@ struct SceneRun {
   std::vector<TimedError> curve;  ///< subsampling's time->error curve
 
   SceneRun(const Scene& sc, const Setup& s, const CameraSpec& cam, const volume::RenderOptions& render)
-      : setup(s), caster(sc.vol, sc.tf, cam, render), geometry(sampling::build_feature_geometry(sc.vol, sc.tf)) {
+      : setup(s), scene(sc), caster(sc.vol, sc.tf, cam, render), geometry(sampling::build_feature_geometry(sc.vol, sc.tf)) {
     full_ms = min_ms(2, [&] { full = volume::render_full(caster).image; });
     lines_ms = min_ms(2, [&] { lines = sampling::frame_importance(caster, &geometry, setup.features); });
     bg_ms = min_ms(2, [&] { background = sampling::frame_importance(caster, nullptr, {}); });
@@ -290,6 +321,28 @@ struct SceneRun {
                   lines_skipped, full_now);
     }
   }
+
+  // The orbit figures: the path renderer of `raysift render --camera-path --target-fps` on an orbit about the
+  // view's target through its eye, at 3x the full-render rate timed just before. Each frame is scored against
+  // its own full render in the sink, outside the frame's time.
+  void orbit() const {
+    const double full_now = min_ms(2, [&] { volume::render_full(caster); });
+    sampling::PathRenderOptions options;
+    options.sampling = setup.sampling;
+    options.features.lines = setup.features;
+    options.target_fps = 3 * 1000.0 / full_now;
+    const std::vector<CameraSpec> cameras =
+        sampling::orbit_cameras(sampling::orbit_through(caster.camera().spec(), setup.orbit_frames));
+    const auto bricks = volume::build_volume_bricks(scene.vol);
+    std::vector<Error> errors;
+    const std::vector<sampling::PathFrame> frames = sampling::render_camera_path(
+        scene.vol, scene.tf, caster.options(), cameras, &geometry, options,
+        [&](const sampling::PathFrame& f, const ImageRGBA& image) {
+          const volume::RayCaster reference(scene.vol, bricks, scene.tf, cameras[std::size_t(f.index)], caster.options());
+          errors.push_back(error_of(volume::render_full(reference).image, image));
+        });
+    print_orbit(frames, errors, options.target_fps, full_now);
+  }
 };
 
 void run_scene(const Scene& sc, const Setup& setup, int width, int height, bool budget_table) {
@@ -299,6 +352,10 @@ void run_scene(const Scene& sc, const Setup& setup, int width, int height, bool 
   volume::RenderOptions render;
   render.shading = volume::Shading::Phong;
   SceneRun run(sc, setup, cam, render);
+  if (setup.orbit_only) {
+    if (setup.orbit_frames > 0) run.orbit();
+    return;
+  }
   for (int k = 1; k < setup.overhead_only; ++k) run.overhead();
   run.overhead();
   if (setup.overhead_only > 0) return;
@@ -310,6 +367,7 @@ void run_scene(const Scene& sc, const Setup& setup, int width, int height, bool 
   run.equal_time();
   run.equal_rays();
   if (budget_table && setup.budget_frames > 0) run.budget_table();
+  if (setup.orbit_frames > 0) run.orbit();
 }
 
 bool listed(const std::string& list, const std::string& name) {
@@ -342,17 +400,19 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--budget-only")) setup.budget_only = true;
     else if (!std::strcmp(argv[i], "--spacing") && more) setup.sampling.base_spacing = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--max-budget-share") && more) setup.features.max_budget_share = std::stod(argv[++i]);
+    else if (!std::strcmp(argv[i], "--orbit-only")) setup.orbit_only = true;
+    else if (!std::strcmp(argv[i], "--orbit-frames") && more) setup.orbit_frames = std::atoi(argv[++i]);
     else {
       std::fprintf(stderr, "usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--linear] [--floor F] "
-                           "[--line-weight W] [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N] [--budget-only] [--spacing S] [--max-budget-share K]\n");
+                           "[--line-weight W] [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N] [--budget-only] [--spacing S] [--max-budget-share K] [--orbit-only] [--orbit-frames N]\n");
       return 2;
     }
   }
-  setup.features.classes = sampling::parse_feature_list("contours,silhouettes");
+  setup.features.classes = sampling::parse_feature_list(sampling::kDefaultFeatures);
   const int width = quick ? 720 : 1440, height = quick ? 450 : 900;
   const auto& a = setup.sampling.mapping.alpha;
-  std::printf("prioritized_bench: %dx%d, phong, contours+silhouettes, %s reconstruction, refinement %s (floor %g, "
-              "line weight %g), alpha %g,%g,%g,%g,%g,%g, base spacing %d\n", width, height,
+  std::printf("prioritized_bench: %dx%d, phong, features %s, %s reconstruction, refinement %s (floor %g, "
+              "line weight %g), alpha %g,%g,%g,%g,%g,%g, base spacing %d\n", width, height, sampling::kDefaultFeatures,
               setup.sampling.interpolation == sampling::Interpolation::Cubic ? "cubic" : "linear",
               setup.sampling.refinement.enabled ? "on" : "off",
               setup.sampling.refinement.floor, setup.sampling.refinement.line_weight, a[0], a[1], a[2], a[3], a[4],

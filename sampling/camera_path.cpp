@@ -1,5 +1,6 @@
 #include "sampling/camera_path.h"
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cmath>
@@ -85,11 +86,17 @@ struct RayCache {
       : colour(w, h), depth(w, h, std::numeric_limits<float>::infinity()), known(std::size_t(w) * std::size_t(h), 0) {}
 };
 
+/// What a frame's tracer actually traced (rays not in the cache) and the volume samples those rays took.
+struct TraceCounts {
+  std::atomic<std::size_t> rays{0};
+  std::atomic<std::uint64_t> samples{0};
+};
+
 /// A batch tracer over `cache`: known pixels are copied, the others traced (their colour and depth
-/// stored). Calls touch disjoint pixels (scheduler contract), so the cache needs no lock; `new_rays`
-/// counts what was actually traced.
-TraceBatch cached_trace(const volume::RayCaster& caster, RayCache& cache, std::atomic<std::size_t>& new_rays) {
-  return [&caster, &cache, &new_rays](Span<const std::uint32_t> pixels, Span<Rgba> out) {
+/// stored). Calls touch disjoint pixels (scheduler contract), so the cache needs no lock; `counts`
+/// receives what was actually traced.
+TraceBatch cached_trace(const volume::RayCaster& caster, RayCache& cache, TraceCounts& counts) {
+  return [&caster, &cache, &counts](Span<const std::uint32_t> pixels, Span<Rgba> out) {
     std::array<std::uint32_t, kRayGroup> todo{};
     std::array<std::size_t, kRayGroup> slot{};
     std::array<volume::RaySample, kRayGroup> samples;
@@ -106,12 +113,15 @@ TraceBatch cached_trace(const volume::RayCaster& caster, RayCache& cache, std::a
         }
       }
       caster.trace_pixels(Span<const std::uint32_t>(todo.data(), m), Span<volume::RaySample>(samples.data(), m));
+      std::uint64_t taken = 0;
       for (std::size_t k = 0; k < m; ++k) {
         out[slot[k]] = cache.colour.pixels[todo[k]] = samples[k].color;
         cache.depth.pixels[todo[k]] = samples[k].depth;
         cache.known[todo[k]] = 1;
+        taken += samples[k].samples;
       }
-      new_rays += m;
+      counts.rays += m;
+      counts.samples += taken;
     }
   };
 }
@@ -133,6 +143,21 @@ double mean_ssim(const ImageRGBA& reference, const ImageRGBA& test) {
 /// the RP paper only says α00 is increased): a few frames take the default mapping to every ray.
 constexpr float kRefineStep = 0.2f;
 
+/// An orbit's frame: its axis (normalised `up`), the direction of angle 0 (the coordinate axis least aligned
+/// with `up`, made perpendicular to it) and the direction of angle 90 degrees. \throw InvalidInput for up = 0.
+struct OrbitBasis {
+  Vec3d axis, u, v;
+};
+OrbitBasis orbit_basis(const Vec3d& up) {
+  const Vec3d axis = normalize(up);
+  if (length(axis) == 0.0) throw InvalidInput("orbit: up must not be the zero vector");
+  Vec3d start{0, 0, 1};
+  for (const Vec3d& candidate : {Vec3d{0, 0, 1}, Vec3d{1, 0, 0}, Vec3d{0, 1, 0}})
+    if (std::abs(dot(candidate, axis)) < std::abs(dot(start, axis)) - 1e-12) start = candidate;
+  const Vec3d u = normalize(start - axis * dot(start, axis));
+  return {axis, u, cross(axis, u)};
+}
+
 }  // namespace
 
 std::vector<CameraSpec> orbit_cameras(const OrbitSpec& orbit) {
@@ -152,14 +177,7 @@ std::vector<CameraSpec> orbit_cameras(const OrbitSpec& orbit) {
     why << "orbit: frames must be >= 1, got " << orbit.frames;
     throw InvalidInput(why.str());
   }
-  const Vec3d axis = normalize(orbit.up);
-  if (length(axis) == 0.0) throw InvalidInput("orbit: up must not be the zero vector");
-  // Start direction: the coordinate axis least aligned with `up`, made perpendicular to it.
-  Vec3d start{0, 0, 1};
-  for (const Vec3d& candidate : {Vec3d{0, 0, 1}, Vec3d{1, 0, 0}, Vec3d{0, 1, 0}})
-    if (std::abs(dot(candidate, axis)) < std::abs(dot(start, axis)) - 1e-12) start = candidate;
-  const Vec3d u = normalize(start - axis * dot(start, axis));
-  const Vec3d v = cross(axis, u);
+  const auto [axis, u, v] = orbit_basis(orbit.up);
   const double elevation = orbit.elevation_deg * M_PI / 180.0;
   std::vector<CameraSpec> cameras;
   for (int i = 0; i < orbit.frames; ++i) {
@@ -176,6 +194,23 @@ std::vector<CameraSpec> orbit_cameras(const OrbitSpec& orbit) {
     cameras.push_back(spec);
   }
   return cameras;
+}
+
+OrbitSpec orbit_through(const CameraSpec& camera, int frames) {
+  const auto [axis, u, v] = orbit_basis(camera.up);
+  const Vec3d d = camera.eye - camera.target;
+  OrbitSpec orbit;
+  orbit.centre = camera.target;
+  orbit.radius = length(d);
+  if (!(orbit.radius > 0)) throw InvalidInput("orbit: the camera's eye is its target");
+  orbit.elevation_deg = std::asin(std::clamp(dot(d, axis) / orbit.radius, -1.0, 1.0)) * 180.0 / M_PI;
+  orbit.start_deg = std::atan2(dot(d, v), dot(d, u)) * 180.0 / M_PI;
+  orbit.frames = frames;
+  orbit.up = axis;
+  orbit.fov_y_deg = camera.fov_y_deg;
+  orbit.width = camera.width;
+  orbit.height = camera.height;
+  return orbit;
 }
 
 std::vector<CameraSpec> camera_path_from_json(const Json& json, const std::string& source,
@@ -335,6 +370,7 @@ ImageRGBA full_frame(const volume::RayCaster& caster, PathState& st, PathFrame& 
   if (frame.refined) return st.previous->image;
   volume::RenderResult r = volume::render_full(caster);
   frame.rays_traced = std::size_t(r.rays_traced);
+  frame.samples = r.samples;
   frame.trace_ms = clock.elapsed_ms();
   st.cache = std::make_unique<RayCache>(caster.width(), caster.height());
   st.cache->depth = std::move(r.depth);
@@ -390,11 +426,13 @@ ImageRGBA sampled_frame(const volume::RayCaster& caster, const FeatureGeometry* 
     so = prioritized_options(st, frame);
     frame.alpha00 = so.mapping.alpha[0];
   }
-  std::atomic<std::size_t> new_rays{0};
+  TraceCounts counts;
   const SampledFrame s =
-      render_sampled(st.still_importance, cached_trace(caster, *st.cache, new_rays), so, clock.elapsed_ms());
+      render_sampled(st.still_importance, cached_trace(caster, *st.cache, counts), so, clock.elapsed_ms());
+  const std::size_t new_rays = counts.rays;
   st.cache->traced += new_rays;
   frame.rays_traced = new_rays;
+  frame.samples = counts.samples;
   frame.full_rays = s.full_rays;
   frame.trace_ms = s.trace_ms;
   st.last_timing = {0, s.trace_ms, new_rays};

@@ -6,6 +6,7 @@
 /// design decision: a path is just a vector of validated CameraSpec and every frame goes through the
 /// same single-frame machinery (render_full / render_sampled / ProgressiveSampler), so every mode works
 /// on a path and a one-frame path equals a single render.
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <optional>
@@ -36,6 +37,11 @@ struct OrbitSpec {
 /// Cameras of an orbit. Angle 0 puts the eye on the side of the axis among x, y, z least aligned with
 /// `up` (for up = +y: on +z). \throw InvalidInput for a bad field (named) or an invalid camera.
 std::vector<CameraSpec> orbit_cameras(const OrbitSpec& orbit);
+
+/// The orbit of `frames` cameras about `camera`'s target and up axis whose frame 0 is `camera`'s eye (the view
+/// size and field of view are the camera's; every frame's up is the axis). \throw InvalidInput for up = 0 or
+/// eye = target; orbit_cameras throws for an eye on the axis.
+OrbitSpec orbit_through(const CameraSpec& camera, int frames);
 
 /// \brief Reads a path: a JSON list of camera objects, {"cameras": [...]}, or {"orbit": {"centre",
 /// "radius", "elevation_deg", "frames", optional "start_deg", "sweep_deg", "up", "fov_y_deg", "width",
@@ -98,7 +104,8 @@ struct PathFrame {
   double importance_ms = 0;     ///< lines + background + saliency (included in ms)
   double saliency_ms = 0;       ///< saliency + warp (included in importance_ms)
   double trace_ms = 0;          ///< tracing alone (included in ms)
-  std::size_t rays_traced = 0;
+  std::size_t rays_traced = 0;  ///< rays this frame traced (a still camera's reused rays are not counted)
+  std::uint64_t samples = 0;    ///< volume samples taken by those rays (as a single render's `samples`)
   std::size_t full_rays = 0;    ///< rays of the full render of this view
   float alpha00 = 0;            ///< α00 used (target-fps: the controller's choice)
   bool refined = false;         ///< same camera as before: previous rays kept, refinement continued

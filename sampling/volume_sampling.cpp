@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <sstream>
 
 #include "core/errors.h"
 #include "core/parallel.h"
@@ -33,6 +34,15 @@ FeatureGeometry feature_geometry_for(const volume::Volume& volume, const volume:
 features::LineClassSet parse_feature_list(const std::string& list) {
   if (list == "none") return {};
   return features::parse_line_classes(list);
+}
+
+std::vector<std::string> feature_list_entries(const std::string& list) {
+  std::vector<std::string> entries;
+  std::stringstream items(list);
+  std::string item;
+  while (std::getline(items, item, ','))
+    if (!item.empty()) entries.push_back(item);
+  return entries;
 }
 
 LinesCost LinesCost::fitted(double measured_ms, std::size_t triangles, std::size_t frame_pixels) const {

@@ -58,8 +58,14 @@ struct FeatureOptions {
 /// The rule above: true when `lines_ms` fits `max_share` of `budget_ms` (always when no budget is set).
 bool lines_fit_budget(double lines_ms, double budget_ms, double max_share);
 
+/// The line classes every front end defaults to (render, sweep, demo, Python, serve, the benches): one list,
+/// so the defaults and the help texts that print them cannot drift apart.
+inline constexpr const char* kDefaultFeatures = "contours,silhouettes";
+
 /// \throw InvalidInput unless `list` is "none" or a --features class list (see features::parse_line_classes).
 features::LineClassSet parse_feature_list(const std::string& list);
+/// The entries of a comma-separated --features list, empty ones dropped ("a,,b" -> {"a", "b"}); not checked.
+std::vector<std::string> feature_list_entries(const std::string& list);
 
 /// Frame-resolution importance: -1 exactly where caster.pixel_is_background(x, y), else the line
 /// importance sampled at the pixel (0 when `geometry` is null or no class is enabled).

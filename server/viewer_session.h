@@ -45,7 +45,7 @@ class ViewerSession : public ConnectionHandler {
   struct Settings {
     std::string mode = "prioritized";  ///< prioritized | subsample | full
     double target_fps = 10;
-    std::vector<std::string> features{"contours", "silhouettes"};
+    std::vector<std::string> features = sampling::feature_list_entries(sampling::kDefaultFeatures);
     std::string show = "image";        ///< image | traced | importance
     std::string format = "png";        ///< png (byte-equal to the CLI's) | jpeg (when jpeg_available())
   };

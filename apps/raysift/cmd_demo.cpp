@@ -90,7 +90,7 @@ RegisterCommand reg(
 
         sampling::EqualTimeOptions options = opt->lib;
         options.sampling.seed = common.seed;
-        options.features.classes = sampling::parse_feature_list("contours,silhouettes");
+        options.features.classes = sampling::parse_feature_list(sampling::kDefaultFeatures);
         isosurface::FeatureGeometryOptions geometry_options;
         geometry_options.view = isosurface::FeatureView{camera, options.features.importance.scale};
         const sampling::FeatureGeometry geometry = isosurface::build_feature_geometry(in.volume, *in.tf, geometry_options);

@@ -29,7 +29,7 @@ struct SweepOptions {
   VolumeFlags input;  ///< --grid, --tf, --tf-normalized (the volume is the scene's)
   std::vector<double> fractions = sampling::TradeOptions{}.ray_fractions;
   std::vector<double> budgets_ms, time_fractions, steps, early_terminations;
-  std::string features = "contours,silhouettes";
+  std::string features = sampling::kDefaultFeatures;
   std::vector<float> alpha;
   std::string feature_mesh;
   std::string shading = "phong";

@@ -1,6 +1,7 @@
 #include "apps/raysift/lines_flags.h"
 
 #include <cmath>
+#include <sstream>
 
 #include "apps/raysift/cli_checks.h"
 #include "core/errors.h"
@@ -51,6 +52,18 @@ CLI::Validator line_class_list() {
       "", "line classes");
 }
 
+/// --priority's help with the defaults of features::ImportanceOptions (never a hand-copied list).
+std::string priority_help() {
+  std::string help = "class priority overrides, e.g. contours=1,ridges=0.3 (defaults:";
+  const auto& priority = features::ImportanceOptions{}.priority;
+  for (int c = 0; c < features::kLineClassCount; ++c) {
+    std::ostringstream value;
+    value << priority[std::size_t(c)];
+    help += std::string(c ? ", " : " ") + features::line_class_name(features::LineClass(c)) + "=" + value.str();
+  }
+  return help + ")";
+}
+
 }  // namespace
 
 void add_lines_options(CLI::App& sub, LinesCliOptions& o) {
@@ -83,9 +96,7 @@ void add_lines_options(CLI::App& sub, LinesCliOptions& o) {
       ->check(number_in(0, 1, End::Open))->capture_default_str();
   importance->add_option("--falloff-px", lib.importance.falloff_px, "importance fall-off radius around lines, frame pixels")
       ->check(number_in(0, INFINITY, End::Open))->capture_default_str();
-  importance->add_option("--priority", o.priorities,
-                         "class priority overrides, e.g. contours=1,ridges=0.3 (defaults: contours, silhouettes 1.0; "
-                         "others 0.6)")
+  importance->add_option("--priority", o.priorities, priority_help())
       ->delimiter(',')->check(priority_entry());
   auto* output = sub.add_option_group("Output");
   output->add_option("-o,--out", o.out, "picture of the lines over the shaded mesh (.png)")->required()

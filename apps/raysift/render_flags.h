@@ -35,7 +35,7 @@ struct RenderCliOptions {
   // Sampled modes (prioritized, subsample): sampling/volume_sampling.h.
   double ray_fraction = sampling::SamplingOptions{}.ray_fraction;
   double budget_ms = 0;
-  std::string features = "contours,silhouettes";
+  std::string features = sampling::kDefaultFeatures;
   std::vector<float> alpha;     ///< a00,a10,a01,a11,a20,a02; empty = library default
   int progressive = 0;
   std::string feature_mesh;

@@ -24,7 +24,7 @@ namespace raysift::app {
 struct RenderKeywords {
   std::string mode = "full";  ///< full | prioritized | subsample
   std::optional<double> ray_fraction, budget_ms;
-  std::string features = "contours,silhouettes";
+  std::string features = sampling::kDefaultFeatures;
   std::optional<std::vector<float>> alpha;  ///< a00,a10,a01,a11,a20,a02
   std::string shading = "none";
   double step = volume::RenderOptions{}.step_voxels;

@@ -5,6 +5,7 @@
 
 #include "apps/raysift/cli_checks.h"
 #include "sampling/ray_order.h"
+#include "sampling/volume_sampling.h"
 
 namespace raysift::app {
 
@@ -32,12 +33,10 @@ void add_alpha_option(CLI::App& app, std::vector<float>& alpha, const std::strin
 std::string split_saliency_feature(const std::string& list, bool& has_saliency) {
   has_saliency = false;
   std::string rest;
-  std::stringstream items(list);
-  std::string item;
-  while (std::getline(items, item, ',')) {
+  for (const std::string& item : sampling::feature_list_entries(list)) {
     if (item == "saliency") {
       has_saliency = true;
-    } else if (!item.empty() && item != "none") {
+    } else if (item != "none") {
       rest += (rest.empty() ? "" : ",") + item;
     }
   }

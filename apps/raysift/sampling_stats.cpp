@@ -63,10 +63,13 @@ Json path_stats_json(const std::vector<sampling::PathFrame>& frames, double targ
               {"saliency_ms", f.saliency_ms},
               {"trace_ms", f.trace_ms},
               {"rays_traced", f.rays_traced},
+              {"samples", f.samples},
               {"full_rays", f.full_rays},
               {"alpha00", f.alpha00},
               {"refined", f.refined},
               {"lines_skipped", f.lines_skipped}};
+    // The single-frame key for the frame time (its flat twins above are kept: they are a contract too).
+    j["times_ms"] = {{"frame", f.ms}, {"importance", f.importance_ms}, {"saliency", f.saliency_ms}, {"trace", f.trace_ms}};
     j["ssim_vs_full"] = std::isfinite(f.ssim_vs_full) ? Json(f.ssim_vs_full) : Json(nullptr);
     list.push_back(j);
   }

@@ -15,9 +15,9 @@ namespace raysift::app {
 /// features_setup_ms {...}, and progressive (per frame rays_traced, total_ms, budget_too_small) when progressive.
 Json sampled_render_json(const sampling::SampledRender& render, double budget_ms);
 
-/// {"frames": [{index, ms, importance_ms, saliency_ms, trace_ms, rays_traced, full_rays, alpha00, refined,
-/// ssim_vs_full (null without compare)}], target_ms and within_10pct_of_target (with a target),
-/// mean_ssim_vs_full (when compared)}.
+/// {"frames": [{index, ms, importance_ms, saliency_ms, trace_ms, times_ms {frame (= ms), importance, saliency,
+/// trace}, rays_traced, samples, full_rays, alpha00, refined, lines_skipped, ssim_vs_full (null without compare)}],
+/// target_ms and within_10pct_of_target (with a target), mean_ssim_vs_full (when compared)}.
 Json path_stats_json(const std::vector<sampling::PathFrame>& frames, double target_fps);
 
 }  // namespace raysift::app

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "core/image.h"
 #include "core/json_io.h"
@@ -90,6 +91,42 @@ TEST(RenderPathCli, SsimVsFullIsTheFrameScoredAgainstAStandaloneFullRender) {
   const double ssim = read_json_file(dir + "/cmp.json").at("ssim").get<double>();
   EXPECT_LT(ssim, 1.0);
   EXPECT_EQ(part.at("ssim_vs_full").get<double>(), ssim);
+}
+
+// Every path frame reports the single-frame keys times_ms.frame (its frame time, = ms) and samples (the volume
+// samples its rays took). A one-camera path is a single render, so there both equal what `raysift render` reports
+// for that camera, in every mode.
+TEST(RenderPathCli, FramesReportFrameTimeAndSamplesAsASingleRender) {
+  const std::string dir = test::make_temp_dir("render_path_cli_samples");
+  const Json cameras = Json::parse(kTwoCameras);
+  write_json_file(dir + "/path.json", cameras);
+  write_json_file(dir + "/one.json", Json::array({cameras.at(1)}));
+  write_json_file(dir + "/cam1.json", cameras.at(1));
+  const std::vector<std::string> modes = {"full", "prioritized", "subsample"};
+  std::vector<std::string> args;
+  for (const std::string& m : modes) {
+    const std::string mode = "--mode " + m + (m == "full" ? "" : " --ray-fraction 0.3");
+    args.push_back(engine_render("--camera-path path.json " + mode + " -o " + m + "_path_%d.exr --stats " + m + "_path.json"));
+    args.push_back(engine_render("--camera-path one.json " + mode + " -o " + m + "_one_%d.exr --stats " + m + "_one.json"));
+    args.push_back(engine_render("--camera cam1.json " + mode + " -o " + m + "_single.exr --stats " + m + "_single.json"));
+  }
+  for (const auto& r : test::run_cli_all(RAYSIFT_EXE, dir, args)) ASSERT_EQ(r.code, 0) << r.err;
+  for (const std::string& m : modes) {
+    const Json path = read_json_file(dir + "/" + m + "_path.json");
+    ASSERT_EQ(path.at("frames").size(), 2u) << m;
+    for (const Json& f : path.at("frames")) {
+      EXPECT_GT(f.at("times_ms").at("frame").get<double>(), 0.0) << m;
+      EXPECT_EQ(f.at("times_ms").at("frame"), f.at("ms")) << m;
+      EXPECT_GT(f.at("samples").get<long>(), 0) << m;
+    }
+    const Json one = read_json_file(dir + "/" + m + "_one.json").at("frames").at(0);
+    const Json single = read_json_file(dir + "/" + m + "_single.json");
+    EXPECT_EQ(one.at("rays_traced"), single.at("rays_traced")) << m;
+    EXPECT_EQ(one.at("samples"), single.at("samples")) << m;
+  }
+  // Subsampling at 0.3 traces fewer rays than the full render, so its rays take fewer samples.
+  EXPECT_LT(read_json_file(dir + "/subsample_one.json").at("frames").at(0).at("samples").get<long>(),
+            read_json_file(dir + "/full_one.json").at("frames").at(0).at("samples").get<long>());
 }
 
 TEST(RenderPathCli, BadPathsAndFlagsFail) {

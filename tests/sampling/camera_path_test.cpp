@@ -40,6 +40,32 @@ TEST(CameraPath, OrbitCamerasLieOnTheCircleAtTheElevation) {
   }
 }
 
+TEST(CameraPath, OrbitThroughACameraStartsAtItsEyeAndKeepsItsHeightOnTheAxis) {
+  CameraSpec c;
+  c.eye = {3, 5, -2};
+  c.target = {1, 1, 1};
+  c.up = {0, 0, -2};  // not normalised, not perpendicular to the view direction
+  c.fov_y_deg = 40;
+  c.width = 64;
+  c.height = 32;
+  const auto cams = orbit_cameras(orbit_through(c, 8));
+  ASSERT_EQ(cams.size(), 8u);
+  EXPECT_NEAR(length(cams[0].eye - c.eye), 0.0, 1e-12);
+  const Vec3d d = c.eye - c.target;
+  for (const CameraSpec& k : cams) {
+    EXPECT_EQ(k.target, c.target);
+    EXPECT_EQ(k.up, (Vec3d{0, 0, -1}));
+    EXPECT_EQ(k.fov_y_deg, 40.0);
+    EXPECT_EQ(k.width, 64);
+    EXPECT_EQ(k.height, 32);
+    EXPECT_NEAR(length(k.eye - c.target), length(d), 1e-12);
+    EXPECT_NEAR(k.eye.z - c.target.z, d.z, 1e-12);  // the eye's height along the axis
+  }
+  EXPECT_NEAR(length(cams[4].eye - c.eye), 2 * std::hypot(d.x, d.y), 1e-12);  // half way round: opposite side
+  c.eye = c.target;
+  EXPECT_THROW(orbit_through(c, 8), InvalidInput);
+}
+
 TEST(CameraPath, ReadsListsAndOrbits) {
   const Json list = Json::parse(R"([{"eye": [0, 0, 5], "target": [0, 0, 0], "width": 64, "height": 32},
                                     {"eye": [1, 0, 5], "target": [0, 0, 0], "width": 64, "height": 32}])");
@@ -190,8 +216,10 @@ TEST_P(StillCamera, ReusesRaysAndConvergesToTheFullRender) {
                                          [&](const PathFrame&, const ImageRGBA& img) { images.push_back(img); });
   ASSERT_EQ(frames.size(), cams.size());
   std::size_t total = 0;
+  std::uint64_t samples = 0;
   for (std::size_t i = 0; i < frames.size(); ++i) {
     EXPECT_EQ(frames[i].refined, i > 0);
+    samples += frames[i].samples;
     if (threshold_mode && i > 0) {
       EXPECT_FLOAT_EQ(frames[i].alpha00, frames[i - 1].alpha00 + 0.2f);
     }
@@ -201,7 +229,10 @@ TEST_P(StillCamera, ReusesRaysAndConvergesToTheFullRender) {
   // Every object ray is traced exactly once over the path, and the last frame is the full render.
   EXPECT_EQ(total, frames.back().full_rays);
   const volume::RayCaster caster(scene.vol, scene.tf, cams.back());
-  EXPECT_EQ(images.back().pixels, volume::render_full(caster).image.pixels);
+  const volume::RenderResult full = volume::render_full(caster);
+  EXPECT_EQ(images.back().pixels, full.image.pixels);
+  // Reused rays take no new samples: the path's samples add up to the full render's.
+  EXPECT_EQ(samples, full.samples);
   EXPECT_LT(frames[0].rays_traced, frames[0].full_rays / 2);
 }
 
@@ -221,6 +252,8 @@ TEST(RenderCameraPath, FullModeOnAnOrbitMatchesSingleRenders) {
     EXPECT_EQ(images[i].pixels, volume::render_full(caster).image.pixels);
     EXPECT_EQ(frames[i].ssim_vs_full, 1.0);
     EXPECT_EQ(frames[i].rays_traced, 48u * 48u);
+    EXPECT_GT(frames[i].samples, 0u);
+    EXPECT_EQ(frames[i].samples, volume::render_full(caster).samples);
   }
   const PathSummary summary = summarize_path(frames, 0);
   EXPECT_EQ(summary.mean_ssim_vs_full, 1.0);
