@@ -3,6 +3,7 @@
 #include "python/py_bindings.h"
 #include "python/py_common.h"
 #include "sampling/trade.h"
+#include "sampling/volume_sampling.h"
 
 namespace raysift::py {
 namespace {
@@ -49,6 +50,7 @@ void bind_sweep(pyb::module_& m) {
         pyb::arg("budgets_ms"), pyb::arg("features"), pyb::arg("alpha"), pyb::arg("shading"), pyb::arg("repeats"),
         pyb::arg("seed"));
   m.attr("_SWEEP_RAY_FRACTIONS") = sampling::TradeOptions{}.ray_fractions;
+  m.attr("_DEFAULT_FEATURES") = sampling::kDefaultFeatures;
 }
 
 }  // namespace raysift::py

@@ -34,7 +34,7 @@ def render(volume, tf, camera, **keywords):
     return Renderer(volume, tf).render(camera, **keywords)
 
 
-def sweep(volume, tf, camera, ray_fractions=None, budgets_ms=(), *, features="contours,silhouettes", alpha=None,
+def sweep(volume, tf, camera, ray_fractions=None, budgets_ms=(), *, features=_raysift._DEFAULT_FEATURES, alpha=None,
           shading="phong", repeats=1, seed=1):
     """`raysift sweep`'s rows: the full render, then prioritized, control and subsample at each ray fraction (and
     prioritized and control at each budget), each a dict with the CSV's columns (numbers as float, empty as None)."""
