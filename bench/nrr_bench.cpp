@@ -2,7 +2,8 @@
 // and Lucy-like statue (bench/heldout_scenes.h), with the same three views in one run:
 //  * render CPU time of each NRR variant relative to conventional images per 3-image set (targets: nrr-pixel
 //    <= 1.5x, nrr-visibility <= 2.5x), and the conventional sampler's rays/s relative to bare Embree
-//    rtcIntersect16 primary rays on the same mesh and camera, timed in the same run (target >= 50%);
+//    rtcIntersect16 primary rays on the same mesh and camera (target >= 50%), all timed in 5 interleaved
+//    rounds (every column once per round), best of the rounds;
 //  * the paper's Table 1 and Table 2 (Xie, Wang & Popescu 2016) in the paper's configuration (pixel
 //    redundancy, three images, the given intermediate frames), each cell beside the paper's value;
 //    Table 2 again with visibility redundancy as the resolution-independent limit (not in the paper).
@@ -116,146 +117,189 @@ std::vector<CameraSpec> sized(std::vector<CameraSpec> views, int res) {
   return views;
 }
 
-/// Best of `repeats` runs, in process CPU time (all threads): on a shared, loaded machine wall-clock
-/// time mostly measures the other processes, CPU time the work done. Ratios use it.
+/// One run in process CPU time (all threads): on a shared, loaded machine wall-clock time mostly
+/// measures the other processes, CPU time the work done. Ratios use it.
 template <typename F>
-double best_ms(int repeats, F&& f) {
-  double best = 1e300;
-  for (int r = 0; r < repeats; ++r) {
-    const std::clock_t start = std::clock();
-    f();
-    best = std::min(best, 1000.0 * double(std::clock() - start) / CLOCKS_PER_SEC);
-  }
-  return best;
+double cpu_ms(F&& f) {
+  const std::clock_t start = std::clock();
+  f();
+  return 1000.0 * double(std::clock() - start) / CLOCKS_PER_SEC;
 }
 
 /// Bare Embree: a plain scene, 4x4-pixel packets through rtcIntersect16 over 16x16 tiles, no culling,
-/// no filter, nothing stored but a checksum. The reference the conventional sampler is measured against.
-double bare_embree_ms(const TriMesh& m, const CameraSpec& spec, int repeats, std::size_t& hits_out) {
-  RTCDevice device = rtcNewDevice(nullptr);
-  RTCScene scene = rtcNewScene(device);
-  RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                        3 * sizeof(float), m.vertex_count()));
-  auto* t = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                           3 * sizeof(unsigned), m.triangle_count()));
-  for (std::size_t i = 0; i < m.vertex_count(); ++i) {
-    v[3 * i] = m.positions[i].x;
-    v[3 * i + 1] = m.positions[i].y;
-    v[3 * i + 2] = m.positions[i].z;
+/// no filter, nothing stored but a hit count. The reference the conventional sampler is measured against.
+class BareEmbree {
+ public:
+  explicit BareEmbree(const TriMesh& m) : device_(rtcNewDevice(nullptr)), scene_(rtcNewScene(device_)) {
+    RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                          3 * sizeof(float), m.vertex_count()));
+    auto* t = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                             3 * sizeof(unsigned), m.triangle_count()));
+    for (std::size_t i = 0; i < m.vertex_count(); ++i) {
+      v[3 * i] = m.positions[i].x;
+      v[3 * i + 1] = m.positions[i].y;
+      v[3 * i + 2] = m.positions[i].z;
+    }
+    for (std::size_t i = 0; i < m.triangle_count(); ++i)
+      for (int k = 0; k < 3; ++k) t[3 * i + k] = m.triangles[i][k];
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(scene_, geom);
+    rtcReleaseGeometry(geom);
+    rtcCommitScene(scene_);
   }
-  for (std::size_t i = 0; i < m.triangle_count(); ++i)
-    for (int k = 0; k < 3; ++k) t[3 * i + k] = m.triangles[i][k];
-  rtcCommitGeometry(geom);
-  rtcAttachGeometry(scene, geom);
-  rtcReleaseGeometry(geom);
-  rtcCommitScene(scene);
-  const Camera cam(spec);
-  const int w = spec.width, h = spec.height, tiles_x = (w + 15) / 16, tiles_y = (h + 15) / 16;
-  std::vector<std::size_t> tile_hits(std::size_t(tiles_x * tiles_y));
-  const double ms = best_ms(repeats, [&] {
+  ~BareEmbree() {
+    rtcReleaseScene(scene_);
+    rtcReleaseDevice(device_);
+  }
+  BareEmbree(const BareEmbree&) = delete;
+  BareEmbree& operator=(const BareEmbree&) = delete;
+
+  /// Primary rays of every pixel of `spec`; returns the number of hits.
+  std::size_t trace(const CameraSpec& spec) const {
+    const Camera cam(spec);
+    const int w = spec.width, h = spec.height, tiles_x = (w + 15) / 16, tiles_y = (h + 15) / 16;
+    std::vector<std::size_t> tile_hits(std::size_t(tiles_x * tiles_y));
     tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y), [&](const tbb::blocked_range<int>& r) {
       RTCIntersectContext ctx;
       rtcInitIntersectContext(&ctx);
       ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
       for (int tile = r.begin(); tile < r.end(); ++tile) {
-        std::size_t n_hits = 0;
         const int x0 = (tile % tiles_x) * 16, y0 = (tile / tiles_x) * 16;
         for (int by = y0; by < std::min(y0 + 16, h); by += 4)
-          for (int bx = x0; bx < std::min(x0 + 16, w); bx += 4) {
-            alignas(64) RTCRayHit16 rh;
-            alignas(64) int valid[16];
-            for (int i = 0; i < 16; ++i) {
-              const int x = bx + i % 4, y = by + i / 4;
-              valid[i] = x < w && y < h ? -1 : 0;
-              const Vec3d d = cam.direction_unit_depth(x + 0.5, y + 0.5);
-              rh.ray.org_x[i] = float(spec.eye.x);
-              rh.ray.org_y[i] = float(spec.eye.y);
-              rh.ray.org_z[i] = float(spec.eye.z);
-              rh.ray.dir_x[i] = float(d.x);
-              rh.ray.dir_y[i] = float(d.y);
-              rh.ray.dir_z[i] = float(d.z);
-              rh.ray.tnear[i] = 0.0f;
-              rh.ray.tfar[i] = 1e30f;
-              rh.ray.time[i] = 0.0f;
-              rh.ray.mask[i] = ~0u;
-              rh.ray.id[i] = unsigned(i);
-              rh.ray.flags[i] = 0;
-              rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-              rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
-            }
-            rtcIntersect16(valid, scene, &ctx, &rh);
-            for (int i = 0; i < 16; ++i) n_hits += valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID ? 1 : 0;
-          }
-        tile_hits[std::size_t(tile)] = n_hits;
+          for (int bx = x0; bx < std::min(x0 + 16, w); bx += 4)
+            tile_hits[std::size_t(tile)] += trace_block(cam, spec, bx, by, &ctx);
       }
     });
-  });
-  hits_out = 0;
-  for (std::size_t n : tile_hits) hits_out += n;
-  rtcReleaseScene(scene);
-  rtcReleaseDevice(device);
-  return ms;
-}
+    std::size_t hits = 0;
+    for (std::size_t n : tile_hits) hits += n;
+    return hits;
+  }
+
+ private:
+  std::size_t trace_block(const Camera& cam, const CameraSpec& spec, int bx, int by, RTCIntersectContext* ctx) const {
+    alignas(64) RTCRayHit16 rh;
+    alignas(64) int valid[16];
+    for (int i = 0; i < 16; ++i) {
+      const int x = bx + i % 4, y = by + i / 4;
+      valid[i] = x < spec.width && y < spec.height ? -1 : 0;
+      const Vec3d d = cam.direction_unit_depth(x + 0.5, y + 0.5);
+      rh.ray.org_x[i] = float(spec.eye.x);
+      rh.ray.org_y[i] = float(spec.eye.y);
+      rh.ray.org_z[i] = float(spec.eye.z);
+      rh.ray.dir_x[i] = float(d.x);
+      rh.ray.dir_y[i] = float(d.y);
+      rh.ray.dir_z[i] = float(d.z);
+      rh.ray.tnear[i] = 0.0f;
+      rh.ray.tfar[i] = 1e30f;
+      rh.ray.time[i] = 0.0f;
+      rh.ray.mask[i] = ~0u;
+      rh.ray.id[i] = unsigned(i);
+      rh.ray.flags[i] = 0;
+      rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect16(valid, scene_, ctx, &rh);
+    std::size_t n_hits = 0;
+    for (int i = 0; i < 16; ++i) n_hits += valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID ? 1 : 0;
+    return n_hits;
+  }
+
+  RTCDevice device_;
+  RTCScene scene_;
+};
 
 /// The NRR variants timed against conventional images, in the library's names.
 const nrr::SamplingMode kTimedModes[] = {nrr::SamplingMode::Conventional, nrr::SamplingMode::NrrPixel,
                                          nrr::SamplingMode::NrrVisibility, nrr::SamplingMode::NrrVisibilityFrustum};
+constexpr std::size_t kModes = sizeof(kTimedModes) / sizeof(kTimedModes[0]);
+/// Columns timed in every round: the modes on 3 views, then on view 0 conventional, trace-only and bare Embree.
+constexpr std::size_t kView0Conv = kModes, kTraceOnly = kModes + 1, kBare = kModes + 2, kColumns = kModes + 3;
+constexpr int kRounds = 5;
 
 /// RayScene alone: culled closest hits over view 0's camera rays in 4x4 blocks, nothing stored.
-double trace_only_ms(const nrr::SampledScene& scene, const CameraSpec& view, int repeats) {
-  const Camera camera(view);
-  const int res = view.width;
-  std::vector<mesh::RayF> rays;
-  for (int by = 0; by < res; by += 4)
-    for (int bx = 0; bx < res; bx += 4)
-      for (int y = by; y < std::min(by + 4, res); ++y)
-        for (int x = bx; x < std::min(bx + 4, res); ++x)
-          rays.push_back({Vec3f(view.eye), Vec3f(camera.direction_unit_depth(x + 0.5, y + 0.5))});
-  std::vector<mesh::Hit> hits(rays.size());
-  mesh::QueryOptions cull;
-  cull.cull_back_faces = true;
-  cull.is_coherent = true;
-  return best_ms(repeats, [&] {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, (rays.size() + 255) / 256), [&](const auto& r) {
+class TraceOnly {
+ public:
+  TraceOnly(const nrr::SampledScene& scene, const CameraSpec& view) : scene_(scene) {
+    const Camera camera(view);
+    const int res = view.width;
+    for (int by = 0; by < res; by += 4)
+      for (int bx = 0; bx < res; bx += 4)
+        for (int y = by; y < std::min(by + 4, res); ++y)
+          for (int x = bx; x < std::min(bx + 4, res); ++x)
+            rays_.push_back({Vec3f(view.eye), Vec3f(camera.direction_unit_depth(x + 0.5, y + 0.5))});
+    hits_.resize(rays_.size());
+  }
+  void run() {
+    mesh::QueryOptions cull;
+    cull.cull_back_faces = true;
+    cull.is_coherent = true;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, (rays_.size() + 255) / 256), [&](const auto& r) {
       for (std::size_t b = r.begin(); b < r.end(); ++b) {
-        const std::size_t n = std::min<std::size_t>(256, rays.size() - 256 * b);
-        scene.rays().intersect(Span<const mesh::RayF>(rays.data() + 256 * b, n),
-                               Span<mesh::Hit>(hits.data() + 256 * b, n), cull);
+        const std::size_t n = std::min<std::size_t>(256, rays_.size() - 256 * b);
+        scene_.rays().intersect(Span<const mesh::RayF>(rays_.data() + 256 * b, n),
+                                Span<mesh::Hit>(hits_.data() + 256 * b, n), cull);
       }
     });
-  });
-}
+  }
 
-void speed_table(const std::vector<NamedScene>& scenes, int res) {
-  const int repeats = 3;
-  std::printf("Render CPU time (all threads), 3 views at %dx%d, best of %d (ms); ratio = per 3-image set vs "
-              "conventional; Mrays per CPU second on view 0\n", res, res, repeats);
-  std::printf("%-13s", "scene");
-  for (nrr::SamplingMode m : kTimedModes) std::printf(" %14s %6s", nrr::to_string(m).c_str(), "ratio");
-  std::printf(" %10s %10s %10s %6s %6s\n", "conv Mr/s", "trace Mr/s", "bare Mr/s", "conv%", "trace%");
-  for (const NamedScene& s : scenes) {
-    const nrr::SampledScene scene(s.mesh);
-    const auto views = sized(s.views, res);
-    std::printf("%-13s", s.name.c_str());
-    double conv_ms = 0;
-    for (nrr::SamplingMode m : kTimedModes) {
+ private:
+  const nrr::SampledScene& scene_;
+  std::vector<mesh::RayF> rays_;
+  std::vector<mesh::Hit> hits_;
+};
+
+/// times[r][c]: CPU ms of column c in round r. Every round runs every column once, in turn, so a burst of
+/// load on the shared machine hits all columns of a round alike and the same-round ratios stay comparable.
+std::vector<std::vector<double>> interleaved_times(const NamedScene& s, int res) {
+  const nrr::SampledScene scene(s.mesh);
+  const auto views = sized(s.views, res);
+  const BareEmbree bare(s.mesh);
+  TraceOnly trace(scene, views[0]);
+  std::vector<std::vector<double>> times(kRounds, std::vector<double>(kColumns));
+  for (auto& round : times) {
+    for (std::size_t m = 0; m < kModes; ++m) {
       nrr::SamplingOptions o;
-      o.mode = m;
-      const double ms = best_ms(repeats, [&] { nrr::render_depth_images(scene, Span<const CameraSpec>(views), o); });
-      if (m == nrr::SamplingMode::Conventional) conv_ms = ms;
-      std::printf(" %14.1f %6.2f", ms, ms / conv_ms);
+      o.mode = kTimedModes[m];
+      round[m] = cpu_ms([&] { nrr::render_depth_images(scene, Span<const CameraSpec>(views), o); });
     }
     nrr::SamplingOptions conv;
     conv.mode = nrr::SamplingMode::Conventional;
-    const double view0_ms =
-        best_ms(repeats, [&] { nrr::render_depth_images(scene, Span<const CameraSpec>(&views[0], 1), conv); });
-    const double trace_ms = trace_only_ms(scene, views[0], repeats);
-    std::size_t bare_hits = 0;
-    const double bare_ms = bare_embree_ms(s.mesh, views[0], repeats, bare_hits);
+    round[kView0Conv] =
+        cpu_ms([&] { nrr::render_depth_images(scene, Span<const CameraSpec>(&views[0], 1), conv); });
+    round[kTraceOnly] = cpu_ms([&] { trace.run(); });
+    round[kBare] = cpu_ms([&] { bare.trace(views[0]); });
+  }
+  return times;
+}
+
+void speed_table(const std::vector<NamedScene>& scenes, int res) {
+  std::printf("Render CPU time (all threads), 3 views at %dx%d, best of %d interleaved rounds (each round runs "
+              "every column once, in turn) (ms); ratio = best / best conventional per 3-image set, [min-max] of the "
+              "same-round ratios; Mrays per CPU second on view 0\n", res, res, kRounds);
+  std::printf("%-13s", "scene");
+  for (nrr::SamplingMode m : kTimedModes) std::printf(" %14s %6s %11s", nrr::to_string(m).c_str(), "ratio", "[rounds]");
+  std::printf(" %10s %10s %10s %6s %6s\n", "conv Mr/s", "trace Mr/s", "bare Mr/s", "conv%", "trace%");
+  for (const NamedScene& s : scenes) {
+    const auto times = interleaved_times(s, res);
+    std::vector<double> best(kColumns, 1e300);
+    for (const auto& round : times)
+      for (std::size_t c = 0; c < kColumns; ++c) best[c] = std::min(best[c], round[c]);
+    std::printf("%-13s", s.name.c_str());
+    for (std::size_t m = 0; m < kModes; ++m) {
+      double lo = 1e300, hi = 0;
+      for (const auto& round : times) {
+        lo = std::min(lo, round[m] / round[0]);
+        hi = std::max(hi, round[m] / round[0]);
+      }
+      char range[32];
+      std::snprintf(range, sizeof range, "[%.2f-%.2f]", lo, hi);
+      std::printf(" %14.1f %6.2f %11s", best[m], best[m] / best[0], range);
+    }
     const double rays = double(res) * res;
-    std::printf(" %10.1f %10.1f %10.1f %5.0f%% %5.0f%%\n", rays / view0_ms / 1e3, rays / trace_ms / 1e3,
-                rays / bare_ms / 1e3, 100.0 * bare_ms / view0_ms, 100.0 * bare_ms / trace_ms);
+    std::printf(" %10.1f %10.1f %10.1f %5.0f%% %5.0f%%\n", rays / best[kView0Conv] / 1e3,
+                rays / best[kTraceOnly] / 1e3, rays / best[kBare] / 1e3, 100.0 * best[kBare] / best[kView0Conv],
+                100.0 * best[kBare] / best[kTraceOnly]);
     std::fflush(stdout);
   }
 }

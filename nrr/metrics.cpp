@@ -30,16 +30,15 @@ std::size_t count_if_index(std::size_t n, bool threaded, const std::function<boo
 }
 
 /// The rule that produced reference image i (for visibility availability in metric 4).
-detail::ImageRule reference_rule(SamplingMode mode, Span<const DepthImage> reference, Span<const Camera> cameras,
-                                 Span<const detail::PixelLookup> lookups, std::size_t i) {
+detail::ImageRule reference_rule(SamplingMode mode, Span<const Camera> cameras, Span<const detail::PixelLookup> lookups,
+                                 std::size_t i) {
   detail::ImageRule rule;
   rule.mode = mode;
   if (mode == SamplingMode::Peel) {
     rule.layer = int(i);
   } else {
-    rule.previous = Span<const DepthImage>(reference.data(), i);
     rule.previous_cameras = Span<const Camera>(cameras.data(), i);
-    if (mode == SamplingMode::NrrPixel) rule.previous_lookups = Span<const detail::PixelLookup>(lookups.data(), i);
+    rule.previous_lookups = Span<const detail::PixelLookup>(lookups.data(), i);
   }
   return rule;
 }
@@ -144,8 +143,8 @@ bool is_available(const MetricsContext& c, const Vec3f& x, mesh::TriangleId id) 
     const Vec3f eye(cam.eye());
     const mesh::RayF ray{eye, x - eye};
     mesh::Hit hit;
-    detail::trace(c.scene, reference_rule(c.mode, c.reference, Span<const Camera>(c.ref_cameras),
-                                                  Span<const detail::PixelLookup>(c.ref_lookups), i),
+    detail::trace(c.scene, reference_rule(c.mode, Span<const Camera>(c.ref_cameras),
+                                          Span<const detail::PixelLookup>(c.ref_lookups), i),
                   Span<const mesh::RayF>(&ray, 1), Span<mesh::Hit>(&hit, 1), false);
     if (hit.triangle_id == id) return true;
   }

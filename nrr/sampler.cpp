@@ -183,11 +183,10 @@ std::vector<DepthImage> render_depth_images(const SampledScene& scene, Span<cons
   images.reserve(views.size());
   std::vector<detail::PixelLookup> lookups;
   for (std::size_t i = 0; i < views.size(); ++i) {
-    if (i > 0 && options.mode == SamplingMode::NrrPixel) lookups.emplace_back(images[i - 1]);
+    if (i > 0 && options.mode != SamplingMode::Conventional) lookups.emplace_back(images[i - 1]);
     images.emplace_back(cameras[i].spec());
     detail::ImageRule rule;
     rule.mode = options.mode;
-    rule.previous = Span<const DepthImage>(images.data(), i);
     rule.previous_cameras = Span<const Camera>(cameras.data(), i);
     rule.previous_lookups = Span<const detail::PixelLookup>(lookups);
     DepthImage& image = images.back();

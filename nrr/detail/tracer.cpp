@@ -70,7 +70,7 @@ PixelLookup::PixelLookup(const DepthImage& image) : projector_(Camera(image.came
   const std::size_t side = std::size_t(1) << kShift;
   blocks_x_ = (std::size_t(image.width) + side - 1) / side;
   const std::size_t blocks_y = (std::size_t(image.height) + side - 1) / side;
-  ids_.assign(blocks_x_ * blocks_y * side * side, ~std::uint32_t(0));
+  ids_.assign(blocks_x_ * blocks_y * side * side, kEmpty);
   for (std::size_t y = 0; y < std::size_t(image.height); ++y)
     for (std::size_t x = 0; x < std::size_t(image.width); ++x) {
       const mesh::TriangleId id = image.triangle_id[y * std::size_t(image.width) + x];
@@ -189,11 +189,10 @@ RedundancyMarker visibility_marker(const SampledScene& scene, const ImageRule& r
     std::vector<mesh::RayF> shadow;
     std::vector<std::size_t> owner;
     std::vector<std::uint8_t> blocked;
-    RAYSIFT_CHECK_OP(rule.previous.size(), ==, rule.previous_cameras.size());
+    RAYSIFT_CHECK_OP(rule.previous_lookups.size(), ==, rule.previous_cameras.size());
     for (std::size_t c = 0; c < rule.previous_cameras.size(); ++c) {
       const Camera& cam = rule.previous_cameras[c];
       const Vec3f eye(cam.eye());
-      const PixelProjector projector(cam);
       shadow.clear();
       owner.clear();
       for (std::size_t k = 0; k < active.size(); ++k) {
@@ -201,8 +200,9 @@ RedundancyMarker visibility_marker(const SampledScene& scene, const ImageRule& r
         const Vec3f x = sample_position(rays[active[k]], found[k].t);
         if (!may_be_visibility_redundant(scene, cam, redundancy, x, found[k].triangle_id)) continue;
         // The earlier image's front face at x's pixel is what usually hides x from that eye.
-        const std::ptrdiff_t pixel = projector.pixel(x);
-        const mesh::TriangleId shown = pixel < 0 ? mesh::kNoTriangle : rule.previous[c].triangle_id[std::size_t(pixel)];
+        const std::uint32_t index = rule.previous_lookups[c].index_at(x);
+        const mesh::TriangleId shown =
+            index == PixelLookup::kEmpty ? mesh::kNoTriangle : mesh::make_triangle_id(0, index);
         if (shown != mesh::kNoTriangle && shown != found[k].triangle_id && surely_crosses(scene, shown, eye, x)) continue;
         shadow.push_back({eye, x - eye, 0.0f, 1.0f - float(tol::kSegmentEndRelative)});
         owner.push_back(k);
@@ -227,11 +227,10 @@ void trace(const SampledScene& scene, const ImageRule& rule, Span<const mesh::Ra
       scene.rays().intersect(rays, hits, options);
       return;
     case SamplingMode::NrrPixel: {
-      if (rule.previous.empty()) {
+      if (rule.previous_lookups.empty()) {
         scene.rays().intersect(rays, hits, options);
         return;
       }
-      RAYSIFT_CHECK_OP(rule.previous_lookups.size(), ==, rule.previous.size());
       const mesh::HitFilter keep_non_redundant = [&](const mesh::HitCandidate& c) {
         const Vec3f x = sample_position(rays[c.ray_index], c.t);
         for (const PixelLookup& lookup : rule.previous_lookups)

@@ -169,6 +169,42 @@ TEST(Sampler, LeanRecordReconstructsTheFullRecord) {
   }
 }
 
+
+// The visibility tracer and the pixel filter read an earlier image's triangles through PixelLookup's
+// blocked 32-bit plane; it must answer what the row-major record holds at the projector's pixel, also
+// for partial 8x8 blocks (61 x 93 is no multiple of 8), points outside the image and behind the eye.
+TEST(Sampler, CompactIdPlaneAnswersWhatTheFullRecordHolds) {
+  const SampledScene scene(small_grass().mesh);
+  CameraSpec spec = small_grass().views.views[1];
+  spec.width = 93;
+  spec.height = 61;
+  const DepthImage image = render(scene, {spec}, SamplingMode::Conventional)[0];
+  const detail::PixelLookup lookup(image);
+  const detail::PixelProjector projector{Camera(spec)};
+  std::vector<Vec3f> points;
+  for (std::size_t p = 0; p < image.pixel_count(); ++p)
+    if (image.has_sample(p)) points.push_back(image.position_ws(p));
+  const TriMesh& m = small_grass().mesh;
+  for (const auto& tri : m.triangles)
+    points.push_back((m.positions[tri[0]] + m.positions[tri[1]] + m.positions[tri[2]]) / 3.0f);
+  for (const Vec3f& v : m.positions) points.push_back(Vec3f(Vec3d(2.0 * spec.eye) - Vec3d(v)));  // behind the eye
+  std::size_t held = 0, empty = 0;
+  for (const Vec3f& x : points) {
+    const std::ptrdiff_t pixel = projector.pixel(x);
+    const mesh::TriangleId full = pixel < 0 ? mesh::kNoTriangle : image.triangle_id[std::size_t(pixel)];
+    const std::uint32_t compact = lookup.index_at(x);
+    if (full == mesh::kNoTriangle) {
+      ASSERT_EQ(compact, detail::PixelLookup::kEmpty);
+      ++empty;
+      continue;
+    }
+    ASSERT_EQ(mesh::make_triangle_id(0, compact), full);
+    ASSERT_TRUE(lookup.holds(x, full));
+    ++held;
+  }
+  EXPECT_GT(held, 5000u);
+  EXPECT_GT(empty, 1000u);
+}
 TEST(Sampler, ConvexMeshLaterImagesHoldOnlyWhatEarlierEyesCannotSee) {
   const TriMesh sphere = mesh::make_icosphere(1.0, 2);
   const SampledScene scene(sphere);
