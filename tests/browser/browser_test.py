@@ -197,8 +197,9 @@ def check_orbit(cdp, deadline):
           f"{lat['max']:.1f} ms over {lat['count']} messages; budget {budget:.1f} ms; p95 = "
           f"{lat['p95'] / budget:.2f} x budget ({verdict} the {LATENCY_BUDGETS} x contract)")
     own = s["reflected_latency_ms"]
-    print(f"  of which the message each frame was rendered from: p50 {own['p50']:.1f} ms, p95 {own['p95']:.1f} ms "
-          f"over {own['count']} frames ({own['p95'] / budget:.2f} x budget)")
+    if own["count"]:  # none when every drawn frame came from a message the page did not time
+        print(f"  of which the message each frame was rendered from: p50 {own['p50']:.1f} ms, p95 {own['p95']:.1f} "
+              f"ms over {own['count']} frames ({own['p95'] / budget:.2f} x budget)")
     if s["frames"] <= before["frames"] or abs(drag["fps"] - target) > RATE_TOLERANCE * target:
         return f"drag frame rate {drag['fps']:.2f} fps is outside {target:g} +-{RATE_TOLERANCE:.0%}"
     return None
