@@ -23,16 +23,11 @@ double distance_to_box(const Vec3d& p, const Vec3d& lo, const Vec3d& hi) {
   return std::sqrt(dx * dx + dy * dy + dz * dz);
 }
 
-double max_voxel_size(const volume::Volume& v) {
-  const Vec3d s = v.voxel_size();
-  return std::max({s.x, s.y, s.z});
-}
-
 /// World-space simplification bound for the view, rounded down to a power of two so that nearby cameras
 /// share one cache entry (rounding down keeps the bound conservative).
-double simplification_error(const volume::Volume& volume, const FeatureGeometryOptions& o) {
+double simplification_error(const volume::GridInfo& info, const FeatureGeometryOptions& o) {
   if (!o.view || !(o.max_error_px > 0)) return 0.0;
-  const double e = o.max_error_px * importance_pixel_size(volume, *o.view);
+  const double e = o.max_error_px * importance_pixel_size(info, *o.view);
   return e > 0 ? std::exp2(std::floor(std::log2(e))) : 0.0;
 }
 
@@ -77,6 +72,22 @@ void split_hidden(const volume::Volume& volume, const volume::Volume& level, int
   isos = std::move(kept);
 }
 
+/// The prepared surfaces of `set` merged into `geometry` (its mesh, iso-values and stage times).
+void take_surfaces(const IsosurfaceSet& set, const std::vector<double>& iso_values, FeatureGeometry& geometry) {
+  geometry.stages = set.stages;
+  geometry.mesh = merge_surfaces(set);
+  geometry.iso_values = iso_values;
+  if (geometry.mesh.triangles.empty())
+    throw InvalidInput("the iso-values chosen for the feature lines give no surface; pass iso-values inside the "
+                       "data range");
+}
+
+void add_curvature(FeatureGeometry& geometry) {
+  const Timer curvature;
+  geometry.curvature = mesh::compute_curvature(geometry.mesh);
+  geometry.curvature_ms = curvature.elapsed_ms();
+}
+
 std::string box_text(const Vec3d& lo, const Vec3d& hi) {
   std::ostringstream s;
   s << "[" << lo.x << ", " << lo.y << ", " << lo.z << "] - [" << hi.x << ", " << hi.y << ", " << hi.z << "]";
@@ -102,24 +113,35 @@ void check_bounds(const TriMesh& m, const volume::Volume& volume, const std::str
 }  // namespace
 
 double importance_pixel_size(const volume::Volume& volume, const FeatureView& view) {
+  return importance_pixel_size(volume.info(), view);
+}
+
+double importance_pixel_size(const volume::GridInfo& info, const FeatureView& view) {
   const Camera camera(view.camera);  // validates the spec
   if (!(view.importance_scale > 0 && view.importance_scale <= 1))
     throw InvalidInput("importance scale must be in (0, 1], got " + std::to_string(view.importance_scale));
-  const volume::GridInfo info = volume.info();
   const double distance = distance_to_box(view.camera.eye, info.bbox_min, info.bbox_max);
   const double buffer_height = std::max(1.0, std::round(view.camera.height * view.importance_scale));
   return 2.0 * distance * std::tan(0.5 * view.camera.fov_y_deg * M_PI / 180.0) / buffer_height;
 }
 
 int choose_coarsening(const volume::Volume& volume, const FeatureGeometryOptions& options) {
+  return choose_feature_level(volume.info(), options).coarsening;
+}
+
+FeatureLevel choose_feature_level(const volume::GridInfo& info, const FeatureGeometryOptions& options) {
+  return {choose_coarsening(info, options), simplification_error(info, options)};
+}
+
+int choose_coarsening(const volume::GridInfo& info, const FeatureGeometryOptions& options) {
   if (options.coarsening != 0) return options.coarsening;
-  if (!options.view || volume.is_empty()) return 1;
-  const double cell_limit = options.cell_px * importance_pixel_size(volume, *options.view);
-  const volume::GridInfo info = volume.info();
+  if (!options.view || info.active_voxels == 0) return 1;
+  const double cell_limit = options.cell_px * importance_pixel_size(info, *options.view);
   const int extent = 1 + std::max({info.index_max.x - info.index_min.x, info.index_max.y - info.index_min.y,
                                    info.index_max.z - info.index_min.z});
   int factor = 1;
-  while (factor < 8 && 2 * factor * max_voxel_size(volume) <= cell_limit && extent / (2 * factor) >= kMinCoarseCells)
+  const double voxel = std::max({info.voxel_size.x, info.voxel_size.y, info.voxel_size.z});
+  while (factor < 8 && 2 * factor * voxel <= cell_limit && extent / (2 * factor) >= kMinCoarseCells)
     factor *= 2;
   return factor;
 }
@@ -128,8 +150,9 @@ FeatureGeometry build_feature_geometry(const volume::Volume& volume, const volum
                                        const FeatureGeometryOptions& options, FeatureCache* cache) {
   const Timer timer;
   FeatureGeometry geometry;
-  geometry.coarsening = choose_coarsening(volume, options);
-  const double max_error = simplification_error(volume, options);
+  const FeatureLevel chosen_level = choose_feature_level(volume.info(), options);
+  geometry.coarsening = chosen_level.coarsening;
+  const double max_error = chosen_level.max_error;
   std::optional<CacheKey> key;
   if (cache) {
     key = feature_cache_key(volume, tf, options_fingerprint(options, geometry.coarsening, max_error));
@@ -153,18 +176,24 @@ FeatureGeometry build_feature_geometry(const volume::Volume& volume, const volum
     stage.reset();
     if (options.drop_hidden) split_hidden(volume, level, geometry.coarsening, tf, chosen.iso_values, geometry.hidden_iso_values);
     geometry.probe_ms = stage.elapsed_ms();
-    const IsosurfaceSet set = build_isosurfaces(level, &tf, pipeline_options(chosen, max_error));
-    geometry.stages = set.stages;
-    geometry.mesh = merge_surfaces(set);
-    geometry.iso_values = chosen.iso_values;
-    if (geometry.mesh.triangles.empty())
-      throw InvalidInput("the iso-values chosen for the feature lines give no surface; pass iso-values inside the "
-                         "data range");
+    take_surfaces(build_isosurfaces(level, &tf, pipeline_options(chosen, max_error)), chosen.iso_values, geometry);
     if (cache) cache->store(*key, {geometry.iso_values, geometry.mesh});
   }
-  const Timer curvature;
-  geometry.curvature = mesh::compute_curvature(geometry.mesh);
-  geometry.curvature_ms = curvature.elapsed_ms();
+  add_curvature(geometry);
+  geometry.build_ms = timer.elapsed_ms();
+  return geometry;
+}
+
+FeatureGeometry finish_feature_geometry(std::vector<TriMesh> raw, const std::vector<double>& iso_values,
+                                        const FeatureGeometryOptions& options, const FeatureLevel& level) {
+  const Timer timer;
+  FeatureGeometry geometry;
+  geometry.coarsening = level.coarsening;
+  std::vector<volume::IsoValue> isos;
+  for (const double v : iso_values) isos.push_back({v, "given"});
+  take_surfaces(prepare_isosurfaces(std::move(raw), isos, pipeline_options(options, level.max_error)), iso_values,
+                geometry);
+  add_curvature(geometry);
   geometry.build_ms = timer.elapsed_ms();
   return geometry;
 }

@@ -60,16 +60,33 @@ struct FeatureGeometryOptions {
 /// Size of one importance-buffer pixel in world units at the point of the volume's bounding box nearest to
 /// the eye (the finest the view resolves anywhere in the volume).
 double importance_pixel_size(const volume::Volume& volume, const FeatureView& view);
+double importance_pixel_size(const volume::GridInfo& info, const FeatureView& view);  ///< from the grid's info
 
 /// The coarsening the options choose for `volume` (1, 2, 4 or 8): monotone, a larger view never gets a
 /// coarser level. The coarse grid keeps at least 32 cells along its longest active extent.
 int choose_coarsening(const volume::Volume& volume, const FeatureGeometryOptions& options);
+int choose_coarsening(const volume::GridInfo& info, const FeatureGeometryOptions& options);  ///< from the grid's info
+
+/// The view-dependent choices of a build: the level and the simplification bound (world units). They depend on
+/// the whole grid's GridInfo alone, so every rank of a split grid makes the same ones.
+struct FeatureLevel {
+  int coarsening = 1;
+  double max_error = 0;
+};
+FeatureLevel choose_feature_level(const volume::GridInfo& info, const FeatureGeometryOptions& options);
 
 /// \brief Builds (or finds in `cache`, when given) the feature geometry.
 /// \throw InvalidInput if the TF is transparent everywhere (no iso-value), or no surface can be extracted;
 ///        Cancelled when the cancel flag is set.
 FeatureGeometry build_feature_geometry(const volume::Volume& volume, const volume::TransferFunction& tf,
                                        const FeatureGeometryOptions& options = {}, FeatureCache* cache = nullptr);
+
+/// \brief The rest of a build on marching-cubes surfaces extracted elsewhere (the bricks of --distribute data,
+/// mpi/distributed_features.h): preparation, merging and curvature. raw[i] is the surface of iso_values[i] on the
+/// level `level` chose. The same steps as build_feature_geometry(), so the same surfaces give the same geometry.
+/// \throw InvalidInput as build_feature_geometry() when no surface remains.
+FeatureGeometry finish_feature_geometry(std::vector<TriMesh> raw, const std::vector<double>& iso_values,
+                                        const FeatureGeometryOptions& options, const FeatureLevel& level);
 
 /// \brief Feature geometry from a prepared mesh file (e.g. the output of `raysift mesh`) instead of the
 /// volume's iso-surfaces. With `volume`, the mesh's bounding box must lie within the volume's world bounding

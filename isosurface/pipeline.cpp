@@ -54,10 +54,9 @@ void add(mesh::StageReport& sum, const mesh::StageReport& part) {
 
 IsosurfaceSet build_isosurfaces(const volume::Volume& volume, const volume::TransferFunction* tf,
                                 const PipelineOptions& options) {
-  IsosurfaceSet set;
   Timer timer;
   const std::vector<volume::IsoValue> isos = choose_iso_values(volume, tf, options);
-  set.stages.iso_choice_ms = timer.elapsed_ms();
+  const double iso_choice_ms = timer.elapsed_ms();
   check_cancel(options);
   if (options.progress) options.progress(0.05);
 
@@ -67,14 +66,24 @@ IsosurfaceSet build_isosurfaces(const volume::Volume& volume, const volume::Tran
   volume::MarchingCubesOptions mc = options.marching_cubes;
   if (!mc.cancel) mc.cancel = options.cancel;
   std::vector<TriMesh> raw = volume::extract_isosurfaces(volume, values, mc);
-  set.stages.marching_cubes.ms = timer.elapsed_ms();
+  const double marching_cubes_ms = timer.elapsed_ms();
+  IsosurfaceSet prepared = prepare_isosurfaces(std::move(raw), isos, options);
+  prepared.stages.iso_choice_ms = iso_choice_ms;
+  prepared.stages.marching_cubes.ms = marching_cubes_ms;
+  return prepared;
+}
+
+IsosurfaceSet prepare_isosurfaces(std::vector<TriMesh> raw, const std::vector<volume::IsoValue>& isos,
+                                  const PipelineOptions& options) {
+  if (raw.size() != isos.size()) throw InvalidInput("prepare_isosurfaces: one mesh per iso-value");
+  IsosurfaceSet set;
   std::size_t mc_triangles = 0;
   for (const TriMesh& m : raw) mc_triangles += m.triangle_count();
   set.stages.marching_cubes.triangles = mc_triangles;
   check_cancel(options);
   if (options.progress) options.progress(0.3);
-  if (mc.memory_limit)
-    require_memory(preparation_bytes(raw, options.prep), *mc.memory_limit, SizeSource::Input,
+  if (options.marching_cubes.memory_limit)
+    require_memory(preparation_bytes(raw, options.prep), *options.marching_cubes.memory_limit, SizeSource::Input,
                    "smoothing and decimating " + std::to_string(mc_triangles) + " triangles");
 
   std::vector<mesh::MeshPrepResult> prepared(raw.size());

@@ -56,6 +56,13 @@ struct IsosurfaceSet {
 IsosurfaceSet build_isosurfaces(const volume::Volume& volume, const volume::TransferFunction* tf,
                                 const PipelineOptions& options = {});
 
+/// \brief The preparation half of build_isosurfaces() (Taubin, simplification, Taubin per surface) on meshes
+/// extracted elsewhere (isosurface/brick_pieces.h): raw[i] is the marching-cubes surface of isos[i]. Stage times
+/// other than the preparation's stay zero.
+/// \throw InvalidInput unless there is one mesh per iso-value, or as build_isosurfaces().
+IsosurfaceSet prepare_isosurfaces(std::vector<TriMesh> raw, const std::vector<volume::IsoValue>& isos,
+                                  const PipelineOptions& options = {});
+
 /// All non-empty surfaces of `set` in one mesh (vertex indices offset), in surface order.
 TriMesh merge_surfaces(const IsosurfaceSet& set);
 

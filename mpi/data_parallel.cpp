@@ -7,6 +7,7 @@
 #include "core/errors.h"
 #include "core/timer.h"
 #include "mpi/composite.h"
+#include "mpi/distributed_features.h"
 #include "mpi/image_parallel.h"
 #include "mpi/session.h"
 
@@ -16,7 +17,7 @@
 
 namespace raysift::mpi {
 
-DataParallelPlan plan_bricks(const std::string& path, const std::string& grid) {
+DataParallelPlan plan_bricks(const std::string& path, const std::string& grid, int ghost) {
   Json plan_json;
   all_or_none([&] {
     if (!is_root()) return;
@@ -25,7 +26,7 @@ DataParallelPlan plan_bricks(const std::string& path, const std::string& grid) {
                  {"active_voxels", layout.active_voxels},
                  {"index_min", {layout.index_min.x, layout.index_min.y, layout.index_min.z}},
                  {"index_max", {layout.index_max.x, layout.index_max.y, layout.index_max.z}},
-                 {"split", kd_split_to_json(kd_split(layout, size()))}};
+                 {"split", kd_split_to_json(kd_split(layout, size(), ghost))}};
   });
   plan_json = broadcast_json(plan_json);
   DataParallelPlan plan;
@@ -158,26 +159,33 @@ Image<std::uint8_t> shared_background(const volume::RayCaster& caster, RankStats
   return background;
 }
 
-/// Prioritized with line classes and a ray fraction (budget frames keep the control, as one process does by
-/// default: max_budget_share = 0).
-bool wants_lines(const sampling::SampledRenderRequest& request) {
-  return request.sampling.mode == sampling::SamplingMode::Prioritized && !request.features.classes.is_empty() &&
-         request.sampling.budget_ms <= 0;
+bool lines_wanted(const sampling::SampledRenderRequest& request) {
+  return wants_lines(request.sampling.mode, request.features.classes, request.sampling.budget_ms);
 }
 
 /// The frame's importance on every rank. Without lines: the control from the shared mask, computed on every
-/// rank. With lines (a --feature-mesh: they need no voxel): rank 0 loads the mesh, rasterises its lines over the
-/// shared mask and broadcasts the importance, as --distribute image does; `summary` gets the mesh's on rank 0.
+/// rank. With lines: rank 0's lines over the shared mask, broadcast, as --distribute image does; they come from
+/// `request.feature_mesh` (loaded by rank 0: lines need no voxel) or from the bricks
+/// (mpi/distributed_features.h). A TF transparent over the whole data range skips them, as one process does.
 ImageF shared_importance(const Image<std::uint8_t>& background, const volume::RayCaster& caster,
-                         const sampling::SampledRenderRequest& request,
-                         std::optional<sampling::FeatureGeometrySummary>& summary, RankStats& stats) {
-  if (!wants_lines(request)) return sampling::frame_importance(background, caster.camera(), nullptr, request.features);
+                         const BrickScene& scene, const sampling::SampledRenderRequest& request,
+                         sampling::SampledRender& out, RankStats& stats) {
+  const bool lines = lines_wanted(request);
+  out.features_skipped = lines && request.feature_mesh.empty() && sampling::transparent_over_data(scene.whole, scene.tf);
+  if (!lines || out.features_skipped)
+    return sampling::frame_importance(background, caster.camera(), nullptr, request.features);
+  std::optional<sampling::FeatureGeometry> geometry;
+  if (request.feature_mesh.empty()) {
+    isosurface::FeatureGeometryOptions options = request.geometry;
+    if (!options.view) options.view = isosurface::FeatureView{caster.camera().spec(), request.features.importance.scale};
+    geometry = build_distributed_feature_geometry(scene.plan, scene.brick, scene.whole, scene.tf, options, stats);
+  }
   ImageF importance(caster.width(), caster.height());
   all_or_none([&] {
     if (!is_root()) return;
-    const sampling::FeatureGeometry geometry = isosurface::load_feature_geometry(request.feature_mesh);
-    summary = sampling::summarize(geometry);
-    importance = sampling::frame_importance(background, caster.camera(), &geometry, request.features);
+    if (!geometry) geometry = isosurface::load_feature_geometry(request.feature_mesh);
+    out.features = sampling::summarize(*geometry);
+    importance = sampling::frame_importance(background, caster.camera(), &*geometry, request.features);
   });
   broadcast_importance(importance, stats);
   return importance;
@@ -185,8 +193,11 @@ ImageF shared_importance(const Image<std::uint8_t>& background, const volume::Ra
 
 }  // namespace
 
-DataSampledFrame render_sampled_data_parallel(const DataParallelPlan& plan, const volume::Volume& brick,
-                                              const volume::TransferFunction& tf, const CameraSpec& camera,
+bool wants_lines(sampling::SamplingMode mode, const features::LineClassSet& classes, double budget_ms) {
+  return mode == sampling::SamplingMode::Prioritized && !classes.is_empty() && budget_ms <= 0;
+}
+
+DataSampledFrame render_sampled_data_parallel(const BrickScene& scene, const CameraSpec& camera,
                                               volume::RenderOptions options,
                                               const sampling::SampledRenderRequest& request, RankStats& stats) {
   const Vec3f background = options.background;
@@ -194,21 +205,17 @@ DataSampledFrame render_sampled_data_parallel(const DataParallelPlan& plan, cons
   all_or_none([&] {  // the same checks on every rank, before the first collective
     if (request.progressive_frames != 0)
       throw UsageError("--distribute data renders single frames; --progressive is not distributed");
-    // Lines from the volume need its iso-surfaces; a rank holds one brick. A prepared mesh needs no voxel.
-    if (wants_lines(request) && request.feature_mesh.empty())
-      throw UsageError("--distribute data computes no feature lines from the volume (each rank holds one brick): "
-                       "pass --feature-mesh (e.g. from raysift mesh), --features none for the control importance, "
-                       "or use --distribute image");
     sampling::validate(request.sampling);
-    caster = std::make_unique<volume::RayCaster>(brick, tf, camera, segment_options(plan, options));
+    caster = std::make_unique<volume::RayCaster>(scene.brick, scene.tf, camera, segment_options(scene.plan, options));
   });
   const Timer total;
-  std::optional<sampling::FeatureGeometrySummary> summary;
-  const ImageF importance = shared_importance(shared_background(*caster, stats), *caster, request, summary, stats);
-  const std::vector<int> order = visibility_order(plan.split, brick.world_to_index(camera.eye));
+  sampling::SampledRender lines;
+  const ImageF importance = shared_importance(shared_background(*caster, stats), *caster, scene, request, lines, stats);
+  const std::vector<int> order = visibility_order(scene.plan.split, scene.brick.world_to_index(camera.eye));
   DataSampledFrame frame;
   frame.render = render_sampled_lockstep(importance, total, *caster, request.sampling, background, order, stats);
-  frame.render.features = std::move(summary);
+  frame.render.features = std::move(lines.features);
+  frame.render.features_skipped = lines.features_skipped;
   frame.visible_blocks = std::uint64_t(sum_all(double(caster->visible_block_count())));
   return frame;
 }

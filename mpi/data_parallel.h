@@ -27,8 +27,10 @@ struct DataParallelPlan {
   KdSplit split;                    ///< brick r belongs to rank r
 };
 
-/// Collective: rank 0 reads the layout (volume::read_vdb_layout) and splits it for size() ranks.
-DataParallelPlan plan_bricks(const std::string& path, const std::string& grid);
+/// Collective: rank 0 reads the layout (volume::read_vdb_layout) and splits it for size() ranks, each brick
+/// reading `ghost` layers (kGhostVoxels for rendering; kFeatureGhostVoxels when the feature geometry is built
+/// from the bricks, mpi/distributed_features.h).
+DataParallelPlan plan_bricks(const std::string& path, const std::string& grid, int ghost = kGhostVoxels);
 
 struct BrickInput {
   volume::Volume volume;    ///< this rank's brick plus ghosts
@@ -57,21 +59,33 @@ DataParallelFrame render_data_parallel(const DataParallelPlan& plan, const volum
                                        const volume::TransferFunction& tf, const CameraSpec& camera,
                                        volume::RenderOptions options);
 
+/// What a rank holds of the scene: the plan, its brick, the whole grid's info, the TF.
+struct BrickScene {
+  const DataParallelPlan& plan;
+  const volume::Volume& brick;
+  const volume::GridInfo& whole;
+  const volume::TransferFunction& tf;
+};
+
 /// \brief Collective: a prioritized or subsample frame in the image mode's lock step (mpi/image_parallel.h), each
 /// set of rays traced as segments on every rank and composited in the k-d visibility order on every rank. The
 /// background mask is computed identically on every rank: a pixel is background iff every rank's brick caster
 /// says so (an all-reduce of the masks, equal to the one-process mask). The importance is the control (background
-/// -1, else 0), or with feature lines from `request.feature_mesh` rank 0's lines over that mask, broadcast.
-/// Rank 0 gets the image.
-/// \throw (as RankFailure on every rank) UsageError for feature lines without a feature mesh (prioritized with
-/// --features and a ray fraction) or progressive frames.
+/// -1, else 0), or with feature lines rank 0's lines over that mask, broadcast: from `request.feature_mesh`, or
+/// from the bricks (mpi/distributed_features.h; \pre the plan's ghosts are kFeatureGhostVoxels then). Rank 0
+/// gets the image.
+/// \throw (as RankFailure on every rank) UsageError for progressive frames.
 struct DataSampledFrame {
   sampling::SampledRender render;    ///< rank 0: image, counts and stage times; elsewhere no image
   std::uint64_t visible_blocks = 0;  ///< summed over ranks, as DataParallelFrame's
 };
-DataSampledFrame render_sampled_data_parallel(const DataParallelPlan& plan, const volume::Volume& brick,
-                                              const volume::TransferFunction& tf, const CameraSpec& camera,
+DataSampledFrame render_sampled_data_parallel(const BrickScene& scene, const CameraSpec& camera,
                                               volume::RenderOptions options,
                                               const sampling::SampledRenderRequest& request, RankStats& stats);
+
+/// Whether a data-parallel frame computes feature lines: prioritized, with line classes and a ray fraction
+/// (budget frames keep the control, as one process does by default: max_budget_share = 0). Without a feature
+/// mesh they come from the bricks, which then need kFeatureGhostVoxels ghost layers.
+bool wants_lines(sampling::SamplingMode mode, const features::LineClassSet& classes, double budget_ms);
 
 }  // namespace raysift::mpi

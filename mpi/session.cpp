@@ -186,6 +186,14 @@ double sum_all(double value) { return reduce(value, Reduction::Sum); }
 double max_all(double value) { return reduce(value, Reduction::Max); }
 double min_all(double value) { return reduce(value, Reduction::Min); }
 
+void sum_all([[maybe_unused]] std::vector<std::uint64_t>& values) {
+#if RAYSIFT_HAVE_MPI
+  if (size() == 1) return;
+  check(MPI_Allreduce(MPI_IN_PLACE, values.data(), int(values.size()), MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD),
+        "MPI_Allreduce");
+#endif
+}
+
 Traffic traffic() { return state().traffic; }
 
 void all_or_none(const std::function<void()>& step) {

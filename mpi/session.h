@@ -57,6 +57,8 @@ void receive(int peer, Span<float> in);
 double sum_all(double value);
 double max_all(double value);
 double min_all(double value);
+/// Element-wise sum over ranks of equally long arrays, in place on every rank (exact: integers).
+void sum_all(std::vector<std::uint64_t>& values);
 
 /// Bytes this rank has sent and received through this API since the session began.
 struct Traffic {

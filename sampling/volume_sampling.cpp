@@ -13,7 +13,10 @@
 namespace raysift::sampling {
 
 bool transparent_over_data(const volume::Volume& volume, const volume::TransferFunction& tf) {
-  const volume::GridInfo info = volume.info();
+  return transparent_over_data(volume.info(), tf);
+}
+
+bool transparent_over_data(const volume::GridInfo& info, const volume::TransferFunction& tf) {
   return volume::max_tf_opacity(tf, info.value_min, info.value_max).opacity <= volume::IsoValueOptions{}.min_opacity;
 }
 

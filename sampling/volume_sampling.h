@@ -158,6 +158,8 @@ void record_frame(SampledRender& out, const SampledFrame& frame, double importan
 /// True when volume::select_iso_values would find no surface (the TF hides every value the volume holds):
 /// render_sampled_volume then renders without feature lines.
 bool transparent_over_data(const volume::Volume& volume, const volume::TransferFunction& tf);
+/// Same from the grid's info (a brick's caller passes the whole grid's).
+bool transparent_over_data(const volume::GridInfo& info, const volume::TransferFunction& tf);
 FeatureGeometrySummary summarize(const FeatureGeometry& geometry);
 
 /// \throw InvalidInput for invalid options (see validate()), a progressive request outside the

@@ -251,7 +251,8 @@ void ViewerSession::render_loop() {
       overhead_ms = 0.5 * (overhead_ms + sent_ms);  // smoothed: one slow send does not halve a budget
       if (is_new && view.settings.mode == "prioritized" && !frame.converged)
         // Capped: when the fixed costs alone exceed the budget, a smaller budget only loses rays, not time.
-        overrun_ms = std::min(0.5 * (overrun_ms + std::max(frame.ms - budget_ms, 0.0)), 0.25 * period_ms);      scene_.stats->frame_sent(view.settings.mode, frame.ms, frame.ms + sent_ms);
+        overrun_ms = std::min(0.5 * (overrun_ms + std::max(frame.ms - budget_ms, 0.0)), 0.25 * period_ms);
+      scene_.stats->frame_sent(view.settings.mode, frame.ms, frame.ms + sent_ms);
     } catch (const Cancelled&) {
       if (cancel_) return;  // else a refinement superseded by a newer view: the loop renders that one next
     } catch (const std::exception& e) {

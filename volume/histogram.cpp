@@ -16,52 +16,68 @@ namespace {
 
 using Tree = openvdb::FloatTree;
 
-/// Folds `visit(acc, value, voxel_count)` over every active value: leaf voxels in parallel (one partial per
-/// chunk, merged by `join`), then the active tiles above the leaves, each standing for many voxels. Callers only
-/// accumulate exact quantities (integer counts, min/max), so the result is the same for any thread count.
+/// Whether index point p lies in the half-open region (null = everywhere).
+bool inside(const IndexRegion* region, const openvdb::Coord& p) {
+  if (!region) return true;
+  for (int a = 0; a < 3; ++a)
+    if (!(double(p[a]) >= region->lo[a] && double(p[a]) < region->hi[a])) return false;
+  return true;
+}
+
+/// Voxels of `box` inside the region (null = all).
+std::uint64_t voxels_inside(const IndexRegion* region, const openvdb::CoordBBox& box) {
+  if (!region) return box.volume();
+  std::uint64_t count = 1;
+  for (int a = 0; a < 3; ++a) {
+    const double lo = std::max(double(box.min()[a]), std::ceil(region->lo[a]));
+    const double hi = std::min(double(box.max()[a]) + 1, std::ceil(region->hi[a]));  // exclusive
+    count *= hi > lo ? std::uint64_t(hi - lo) : 0;
+  }
+  return count;
+}
+
+/// Folds `visit(acc, value, voxel_count)` over every active value in `region` (null = all): leaf voxels in
+/// parallel (one partial per chunk, merged by `join`), then the active tiles above the leaves, each standing for
+/// many voxels. Callers only accumulate exact quantities (integer counts, min/max), so the result is the same for
+/// any thread count.
 template <typename Acc, typename Visit, typename Join>
-Acc reduce_active(const Tree& tree, Acc init, const Visit& visit, const Join& join) {
+Acc reduce_active(const Tree& tree, const IndexRegion* region, Acc init, const Visit& visit, const Join& join) {
   openvdb::tree::LeafManager<const Tree> leaves(tree);
   Acc acc = tbb::parallel_reduce(
       leaves.leafRange(), init,
       [&](const openvdb::tree::LeafManager<const Tree>::LeafRange& r, Acc partial) {
         for (auto leaf = r.begin(); leaf; ++leaf)
-          for (auto v = leaf->cbeginValueOn(); v; ++v) visit(partial, *v, 1);
+          for (auto v = leaf->cbeginValueOn(); v; ++v)
+            if (inside(region, v.getCoord())) visit(partial, *v, 1);
         return partial;
       },
       join);
   Tree::ValueOnCIter tile = tree.cbeginValueOn();
   tile.setMaxDepth(Tree::ValueOnCIter::LEAF_DEPTH - 1);
-  for (; tile; ++tile) visit(acc, *tile, tile.getVoxelCount());
+  for (; tile; ++tile)
+    if (const std::uint64_t n = voxels_inside(region, tile.getBoundingBox())) visit(acc, *tile, n);
   return acc;
 }
 
-struct Range {
-  double min = std::numeric_limits<double>::infinity();
-  double max = -std::numeric_limits<double>::infinity();
-};
-
-Range finite_range(const Tree& tree) {
+ValueRange finite_range(const Tree& tree, const IndexRegion* region) {
   return reduce_active(
-      tree, Range{},
-      [](Range& r, float v, std::uint64_t) {
+      tree, region, ValueRange{},
+      [](ValueRange& r, float v, std::uint64_t) {
         if (!std::isfinite(v)) return;
         r.min = std::min(r.min, double(v));
         r.max = std::max(r.max, double(v));
       },
-      [](Range a, const Range& b) { return Range{std::min(a.min, b.min), std::max(a.max, b.max)}; });
+      [](ValueRange a, const ValueRange& b) { return ValueRange{std::min(a.min, b.min), std::max(a.max, b.max)}; });
 }
 
-}  // namespace
-
-Histogram compute_histogram(const Volume& volume, int bins) {
+Histogram binned(const Tree& tree, int bins, const ValueRange& range, const IndexRegion* region) {
   if (bins < 1) throw InvalidInput("histogram bins must be >= 1, got " + std::to_string(bins));
-  const Tree& tree = volume.impl().grid->tree();
   Histogram h;
   h.counts.assign(std::size_t(bins), 0);
-  const Range range = finite_range(tree);
   if (range.min > range.max) {  // no active voxel, or none finite
-    h.non_finite = tree.activeVoxelCount();
+    h.non_finite = reduce_active(
+        tree, region, std::uint64_t(0), [](std::uint64_t& c, float, std::uint64_t n) { c += n; },
+        [](std::uint64_t a, std::uint64_t b) { return a + b; });
     return h;
   }
   h.min = range.min;
@@ -72,11 +88,12 @@ Histogram compute_histogram(const Volume& volume, int bins) {
   const std::size_t nan_slot = std::size_t(bins);
   auto slot_of = [&](float v) {
     if (!std::isfinite(v)) return nan_slot;
-    return std::min(std::size_t((double(v) - h.min) * scale), std::size_t(bins - 1));
+    const double at = (double(v) - h.min) * scale;
+    return at > 0 ? std::min(std::size_t(at), std::size_t(bins - 1)) : std::size_t(0);
   };
   using Counts = std::vector<std::uint64_t>;
   Counts counts = reduce_active(
-      tree, Counts(std::size_t(bins) + 1, 0), [&](Counts& c, float v, std::uint64_t n) { c[slot_of(v)] += n; },
+      tree, region, Counts(std::size_t(bins) + 1, 0), [&](Counts& c, float v, std::uint64_t n) { c[slot_of(v)] += n; },
       [](Counts a, const Counts& b) {
         for (std::size_t i = 0; i < a.size(); ++i) a[i] += b[i];
         return a;
@@ -85,6 +102,21 @@ Histogram compute_histogram(const Volume& volume, int bins) {
   counts.pop_back();
   h.counts = std::move(counts);
   return h;
+}
+
+}  // namespace
+
+Histogram compute_histogram(const Volume& volume, int bins) {
+  const Tree& tree = volume.impl().grid->tree();
+  return binned(tree, bins, finite_range(tree, nullptr), nullptr);
+}
+
+ValueRange finite_value_range(const Volume& volume, const IndexRegion& region) {
+  return finite_range(volume.impl().grid->tree(), &region);
+}
+
+Histogram compute_histogram(const Volume& volume, int bins, const ValueRange& range, const IndexRegion& region) {
+  return binned(volume.impl().grid->tree(), bins, range, &region);
 }
 
 }  // namespace raysift::volume

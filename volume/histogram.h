@@ -2,8 +2,10 @@
 /// \file Value histogram over a volume's active voxels (tiles count with their voxel count), used by
 /// `raysift info` and by iso-value / transfer-function selection.
 #include <cstdint>
+#include <limits>
 #include <vector>
 
+#include "core/vec.h"
 #include "volume/volume.h"
 
 namespace raysift::volume {
@@ -25,5 +27,22 @@ struct Histogram {
 /// Builds the histogram in parallel (integer counts, so identical for any thread count).
 /// \param bins number of bins, >= 1. \throw InvalidInput if bins < 1.
 Histogram compute_histogram(const Volume& volume, int bins = 256);
+
+/// The half-open index box [lo, hi) of voxel centres one part of a split grid owns (±infinity allowed), so
+/// that the parts' histograms add up to the whole grid's (mpi/distributed_features.cpp).
+struct IndexRegion {
+  Vec3d lo, hi;
+};
+
+/// Range of the finite active values in `region` (min > max when there are none).
+struct ValueRange {
+  double min = std::numeric_limits<double>::infinity();
+  double max = -std::numeric_limits<double>::infinity();
+};
+ValueRange finite_value_range(const Volume& volume, const IndexRegion& region);
+
+/// The histogram of the active voxels in `region`, binned over `range` exactly as compute_histogram() bins the
+/// whole grid over its own range; values outside `range` are clamped into the end bins. \pre range.min <= range.max.
+Histogram compute_histogram(const Volume& volume, int bins, const ValueRange& range, const IndexRegion& region);
 
 }  // namespace raysift::volume

@@ -437,7 +437,7 @@ class EdgeValues {
 /// Pass 3, vertices: one per owned cut edge in edge-id order, interpolated from the lower end point so the
 /// position does not depend on the cell. local[region_edge()] receives each vertex's global index.
 void emit_vertices(const IsoContext& ctx, std::size_t b, const IndexToWorld& to_world, Vec3f* positions,
-                   std::uint32_t* local) {
+                   std::uint32_t* local, McOrigins* origins) {
   // First gather both end values of every owned cut edge (independent loads that overlap their cache
   // misses), then interpolate. Each is one loop over the set bits, without per-axis branches.
   const EdgeValues values(ctx, b);
@@ -467,6 +467,10 @@ void emit_vertices(const IsoContext& ctx, std::size_t b, const IndexToWorld& to_
                               double(origin.y() + y) + (axis == 1 ? t : 0.0),
                               double(origin.z() + z) + (axis == 2 ? t : 0.0));
     local[region_edge(x, y, z, axis)] = next;
+    if (origins) {
+      origins->vertex_edge_lower[next] = {origin.x() + x, origin.y() + y, origin.z() + z};
+      origins->vertex_edge_axis[next] = std::uint8_t(axis);
+    }
     positions[next++] = to_world(p_is);
   }
 }
@@ -504,16 +508,32 @@ void link_neighbour_vertices(const IsoContext& ctx, std::size_t b, const std::ui
 }
 
 /// Pass 3 for one block: vertices, then triangles in cell order (x, y, z) and table order.
+/// Each triangle's cell for block b, in fill_block's order.
+void record_triangle_cells(const IsoContext& ctx, std::size_t b, const std::uint32_t rows[kR * kR],
+                           const CaseTable& corners, Vec3i* cells) {
+  const openvdb::Coord& origin = ctx.blocks.origins[b];
+  for (int x = 0; x < kB; ++x)
+    for (int y = 0; y < kB; ++y) {
+      std::uint64_t column = 0;
+      for (std::uint32_t bits = column_cases(rows, x, y, column); bits; bits &= bits - 1) {
+        const int z = __builtin_ctz(bits);
+        const int triangles = corners[(column >> (8 * z)) & 0xFF].corner_count / 3;
+        for (int t = 0; t < triangles; ++t) *cells++ = {origin.x() + x, origin.y() + y, origin.z() + z};
+      }
+    }
+}
+
 void fill_block(const IsoContext& ctx, std::size_t b, const IndexToWorld& to_world, const CaseTable& corners,
-                TriMesh& mesh) {
+                TriMesh& mesh, McOrigins* origins) {
   if (ctx.counts[b].vertices == 0 && ctx.counts[b].triangles == 0) return;
   std::uint32_t rows[kR * kR];
   block_rows(ctx, b, rows);
   // Vertex index per region edge. Entries of edges that are not cut hold zeros or stale (but defined) values
   // from earlier blocks; only the fixed-length copies below read them, into slots that are then overwritten.
   thread_local std::array<std::uint32_t, kRegionEdges> local{};
-  emit_vertices(ctx, b, to_world, mesh.positions.data(), local.data());
+  emit_vertices(ctx, b, to_world, mesh.positions.data(), local.data(), origins);
   if (ctx.counts[b].triangles == 0) return;
+  if (origins) record_triangle_cells(ctx, b, rows, corners, origins->triangle_cell.data() + ctx.triangle_offset[b]);
   link_neighbour_vertices(ctx, b, rows, local.data());
   constexpr int kCorners = 3 * detail::kMcMaxTriangles;
   std::uint32_t buffer[kB * kB * kB * kCorners + kCorners];  // in L1, then one copy to the mesh
@@ -551,8 +571,8 @@ bool for_each_block(std::size_t n, const MarchingCubesOptions& options, double b
 }
 
 /// One surface; `progress_begin/end` is this iso-value's share of the whole call's progress.
-TriMesh extract(const openvdb::FloatGrid& grid, const BlockSet& blocks, double iso,
-                      const MarchingCubesOptions& options, double progress_begin, double progress_end) {
+TriMesh extract(const openvdb::FloatGrid& grid, const BlockSet& blocks, double iso, const MarchingCubesOptions& options,
+                double progress_begin, double progress_end, McOrigins* origins) {
   float iso_f = float(iso);
   if (double(iso_f) < iso) iso_f = std::nextafter(iso_f, std::numeric_limits<float>::infinity());
   const std::size_t n = blocks.size();
@@ -597,18 +617,31 @@ TriMesh extract(const openvdb::FloatGrid& grid, const BlockSet& blocks, double i
     size_positions();
     size_triangles();
   }
+  if (origins) {
+    origins->vertex_edge_lower.resize(mesh.positions.size());
+    origins->vertex_edge_axis.resize(mesh.positions.size());
+    origins->triangle_cell.resize(mesh.triangles.size());
+  }
   const IndexToWorld to_world(grid.transform());
   // A mirroring transform (a NRRD flip) reverses every triangle's world orientation: undo it here.
   const bool mirrored = grid.transform().isLinear() && grid.transform().baseMap()->getAffineMap()->getMat4().det() < 0;
   const CaseTable& corners = case_corners(options.flip_orientation != mirrored);
   if (!for_each_block(n, options, progress_begin + 0.5 * span, progress_end, [&](std::size_t b) {
-        fill_block(ctx, b, to_world, corners, mesh);
+        fill_block(ctx, b, to_world, corners, mesh, origins);
       }))
     return {};
   return mesh;
 }
 
 }  // namespace
+
+bool mc_point_before(const Vec3i& a, const Vec3i& b) {
+  const std::uint64_t ka = block_key(openvdb::Coord(a.x, a.y, a.z) & ~(kB - 1)),
+                      kb = block_key(openvdb::Coord(b.x, b.y, b.z) & ~(kB - 1));
+  if (ka != kb) return ka < kb;
+  const int la[3] = {a.x & (kB - 1), a.y & (kB - 1), a.z & (kB - 1)}, lb[3] = {b.x & (kB - 1), b.y & (kB - 1), b.z & (kB - 1)};
+  return std::lexicographical_compare(la, la + 3, lb, lb + 3);
+}
 
 std::vector<TriMesh> extract_isosurfaces(const Volume& volume, Span<const double> iso_values,
                                                const MarchingCubesOptions& options) {
@@ -619,10 +652,12 @@ std::vector<TriMesh> extract_isosurfaces(const Volume& volume, Span<const double
   const openvdb::FloatGrid& grid = *volume.impl().grid;
   const BlockSet blocks = collect_blocks(grid.tree(), options.threaded);
   std::vector<TriMesh> meshes(iso_values.size());
+  if (options.origins) options.origins->assign(iso_values.size(), {});
   const double share = 1.0 / double(std::max<std::size_t>(1, iso_values.size()));
   for (std::size_t i = 0; i < iso_values.size(); ++i) {
     if (options.cancel && options.cancel->load()) break;
-    meshes[i] = extract(grid, blocks, iso_values[i], options, double(i) * share, double(i + 1) * share);
+    meshes[i] = extract(grid, blocks, iso_values[i], options, double(i) * share, double(i + 1) * share,
+                        options.origins ? &(*options.origins)[i] : nullptr);
   }
   return meshes;
 }

@@ -6,17 +6,34 @@
 /// and triangles independently; the blocks are concatenated in sorted order and a cut edge's vertex is
 /// owned by the block holding its lower end point, so the output is bit-identical for any thread count and
 /// every cut grid edge yields exactly one shared vertex (watertight, consistently oriented).
+#include <cstdint>
 #include <vector>
 
 #include "core/memory_limit.h"
 #include "core/span.h"
 #include "core/tri_mesh.h"
+#include "core/vec.h"
 #include "volume/volume.h"
 
 namespace raysift::volume {
 
 /// Fraction of a voxel edge kept between a vertex and a grid point (see extract_isosurface()).
 inline constexpr double kEdgeClamp = 0.01;
+
+/// Where each output element of one iso-surface comes from, for reassembling the mesh of a whole grid from
+/// pieces extracted on parts of it (isosurface/brick_pieces.h): vertex i sits on the grid edge from the index
+/// point vertex_edge_lower[i] one step along axis vertex_edge_axis[i]; triangle t lies in the cell whose
+/// lowest corner is triangle_cell[t].
+struct McOrigins {
+  std::vector<Vec3i> vertex_edge_lower;
+  std::vector<std::uint8_t> vertex_edge_axis;
+  std::vector<Vec3i> triangle_cell;
+};
+
+/// The output order of index points: by 8³ block in (z, y, x) order of the block, then (x, y, z) within the
+/// block. Vertices come in the order of (lower end point, axis), triangles in the order of their cell (a cell's
+/// triangles in table order), so sorting pieces by these keys reproduces the whole grid's output.
+bool mc_point_before(const Vec3i& a, const Vec3i& b);
 
 struct MarchingCubesOptions {
   /// Default: triangles are counter-clockwise seen from the side with values below the iso-value, i.e.
@@ -32,6 +49,8 @@ struct MarchingCubesOptions {
   /// If set, the per-block working buffers and then (after the counting pass, before any output array exists)
   /// the mesh itself are checked against it: ResourceError naming the bytes. Null = no check.
   const MemoryLimit* memory_limit = nullptr;
+  /// If set, resized to one entry per iso-value and filled with each surface's McOrigins. Null = not recorded.
+  std::vector<McOrigins>* origins = nullptr;
 };
 
 /// Extracts the iso-surface {f = iso} with the inside predicate f >= iso (strict on one side). Vertices sit

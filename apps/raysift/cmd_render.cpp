@@ -19,6 +19,7 @@
 #include "core/timer.h"
 #include "core/memory_limit.h"
 #include "mpi/data_parallel.h"
+#include "mpi/distributed_features.h"
 #include "mpi/image_parallel.h"
 #include "mpi/session.h"
 #include "volume/volume.h"
@@ -142,11 +143,12 @@ void render_image(const RenderCliOptions& o, const RenderInputs& in, const Commo
 /// --distribute data with --mode prioritized|subsample (mpi/data_parallel.h): the image mode's lock step on
 /// brick segments.
 void render_data_sampled(const RenderCliOptions& o, const RenderInputs& in, const mpi::DataParallelPlan& plan,
-                         const CommonOptions& common, mpi::RankStats stats, const Timer& total) {
+                         const volume::GridInfo& whole, const CommonOptions& common, mpi::RankStats stats,
+                         const Timer& total) {
   const double setup_ms = total.elapsed_ms();
   const Timer trace;
-  mpi::DataSampledFrame frame =
-      mpi::render_sampled_data_parallel(plan, in.volume, *in.tf, in.camera, in.options, in.sampled, stats);
+  mpi::DataSampledFrame frame = mpi::render_sampled_data_parallel({plan, in.volume, whole, *in.tf}, in.camera,
+                                                                  in.options, in.sampled, stats);
   sampling::SampledRender& r = frame.render;
   Json extra = mpi::is_root() ? sampled_render_json(r, in.sampled.sampling.budget_ms) : Json::object();
   ModeOutput out{std::move(r.image), r.rays_traced, r.samples, std::move(extra)};
@@ -172,9 +174,14 @@ void render_distributed(const RenderCliOptions& o, const PathCliOptions& p, cons
   const MemoryLimit limit = memory_limit(common);
   std::string distribute = o.distribute;
   mpi::DataParallelPlan plan;
+  volume::GridInfo whole;  // of the whole grid, also under --distribute data
   mpi::RankStats stats;
+  // Lines built from the bricks read thicker ghosts (mpi/distributed_features.h).
+  const bool lines_from_bricks = o.mode != "full" && o.feature_mesh.empty() &&
+                                 mpi::wants_lines(sampling::parse_sampling_mode(o.mode),
+                                                  sampling::parse_feature_list(o.features), o.budget_ms);
   const VolumeReader reader = [&](const std::string& path, const std::string& grid, const volume::LoadVdbOptions& load) {
-    plan = mpi::plan_bricks(path, grid);
+    plan = mpi::plan_bricks(path, grid, lines_from_bricks ? mpi::kFeatureGhostVoxels : mpi::kGhostVoxels);
     distribute = choose_distribution(distribute, plan.active_voxels, limit);
     if (distribute == "image") {  // every rank holds the whole grid
       VolumeRead whole;
@@ -187,11 +194,12 @@ void render_distributed(const RenderCliOptions& o, const PathCliOptions& p, cons
     }
     mpi::BrickInput brick = mpi::load_brick(plan, path, load, limit);
     stats = brick.stats;
+    whole = brick.info;
     return VolumeRead{std::move(brick.volume), brick.info, brick.non_finite_voxels};
   };
   const RenderInputs in = build_inputs(o, common, reader);
   if (distribute == "image") return render_image(o, in, common, stats, total);  // mpi19b: mpi/image_parallel.h
-  if (o.mode != "full") return render_data_sampled(o, in, plan, common, stats, total);
+  if (o.mode != "full") return render_data_sampled(o, in, plan, whole, common, stats, total);
   const double setup_ms = total.elapsed_ms();
   const Timer trace;
   mpi::DataParallelFrame frame = mpi::render_data_parallel(plan, in.volume, *in.tf, in.camera, in.options);

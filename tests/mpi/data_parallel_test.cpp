@@ -256,15 +256,33 @@ TEST_F(DataParallel, BudgetFrameRendersOnEveryRankCount) {
   }
 }
 
-TEST_F(DataParallel, FeatureLinesAreRefusedWithOneUsageMessage) {
-  write_volume(dir_ + "/v.vdb", 32, slab);
-  const test::CliRun r = ranks(2, dir_, "render v.vdb --tf tf.json --distribute data --mode prioritized -o out.exr");
-  EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("--distribute data computes no feature lines"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("--feature-mesh"), std::string::npos) << r.err;  // the way that works
-  EXPECT_EQ(r.err.find("raysift: error:"), r.err.rfind("raysift: error:")) << r.err;
-  EXPECT_FALSE(fs::exists(dir_ + "/out.exr"));
+/// Lines built from the bricks (mpi/distributed_features.h): the one-process mesh assembled on rank 0, so the
+/// same iso-values and triangles, the same importance and so the same rays and frame. A 48³ volume gets the
+/// full-resolution level (it keeps 32 cells across), the 96³ ball two voxels per cell.
+class DataParallelLines : public DataParallel, public ::testing::WithParamInterface<const char*> {};
+
+TEST_P(DataParallelLines, PrioritizedLinesFromTheVolumeMatchTheSingleProcessFrame) {
+  const std::string volume = GetParam();
+  if (volume == "slab") {
+    write_volume(dir_ + "/v.vdb", 48, slab);
+  } else {
+    const std::string dims = volume == "ball" ? "48,48,48 --radius 18" : "96,96,96 --radius 40";
+    const test::CliRun make = single(dir_, "make-volume ball --dims " + dims + " --quiet -o v.vdb");
+    ASSERT_EQ(make.code, 0) << make.err;
+  }
+  expect_matches("render v.vdb --tf tf.json --camera oblique.json --early-termination 1 --width 64 --height 48 "
+                 "--mode prioritized --ray-fraction 0.25");
+  const Json one = read_json_file(dir_ + "/one.json"), s = read_json_file(dir_ + "/s.json");  // s: the -np 3 run
+  EXPECT_EQ(s["features"], "lines");
+  EXPECT_EQ(s["feature_coarsening"], one["feature_coarsening"]);
+  EXPECT_EQ(s["feature_coarsening"], volume == "big_ball" ? 2 : 1);
+  EXPECT_EQ(s["iso_values"], one["iso_values"]);
+  EXPECT_GT(s["feature_triangles"], 0u);
+  EXPECT_EQ(s["feature_triangles"], one["feature_triangles"]);
 }
+
+INSTANTIATE_TEST_SUITE_P(Volumes, DataParallelLines, ::testing::Values("ball", "slab", "big_ball"),
+                         [](const ::testing::TestParamInfo<const char*>& p) { return std::string(p.param); });
 
 }  // namespace
 }  // namespace raysift

@@ -214,6 +214,62 @@ TEST(MarchingCubes, RandomFieldIsAClosedManifold) {
   }
 }
 
+TEST(MarchingCubes, OriginsNameEachVertexEdgeAndTriangleCellInOutputOrder) {
+  // The tags brick assembly sorts by (isosurface/brick_pieces.h): each vertex lies on its tagged edge, each
+  // triangle's corners on edges of its tagged cell, and both sequences are already in mc_point_before order.
+  // Negative indices and a sheared transform included.
+  DenseSpec spec;
+  spec.dims = {40, 36, 30};
+  spec.axes_ws = std::array<Vec3d, 3>{Vec3d{0.7, 0.1, 0}, Vec3d{0, 0.9, 0.2}, Vec3d{0.1, 0, 1.1}};
+  spec.origin_ws = {-9, -13, -7};
+  const Volume v = Volume::from_function(spec, [](int i, int j, int k) {
+    const double d = std::hypot(i - 18.5, j - 17.0, k - 14.0);
+    return d < 16 ? float(1.0 - d / 16 + 0.02 * ((i * 7 + j * 3 + k) % 5)) : 0.0f;
+  });
+  std::vector<McOrigins> origins;
+  MarchingCubesOptions o;
+  o.origins = &origins;
+  const double isos[2] = {0.35, 0.7};
+  const std::vector<TriMesh> meshes = extract_isosurfaces(v, Span<const double>(isos, 2), o);
+  ASSERT_EQ(origins.size(), 2u);
+  for (std::size_t s = 0; s < 2; ++s) {
+    const TriMesh& m = meshes[s];
+    const McOrigins& g = origins[s];
+    ASSERT_GT(m.triangle_count(), 500u);
+    ASSERT_EQ(g.vertex_edge_lower.size(), m.vertex_count());
+    ASSERT_EQ(g.triangle_cell.size(), m.triangle_count());
+    for (std::size_t i = 0; i < m.vertex_count(); ++i) {
+      const Vec3d p = v.world_to_index(Vec3d(m.positions[i]));
+      const Vec3i& lo = g.vertex_edge_lower[i];
+      const int axis = g.vertex_edge_axis[i];
+      for (int a = 0; a < 3; ++a) {
+        if (a == axis) {
+          EXPECT_GE(p[a] - lo[a], kEdgeClamp - 1e-4) << i;
+          EXPECT_LE(p[a] - lo[a], 1 - kEdgeClamp + 1e-4) << i;
+        } else {
+          EXPECT_NEAR(p[a], lo[a], 1e-4) << i;
+        }
+      }
+      if (i > 0) {
+        const Vec3i& prev = g.vertex_edge_lower[i - 1];
+        const bool ordered = mc_point_before(prev, lo) || (prev == lo && g.vertex_edge_axis[i - 1] < axis);
+        ASSERT_TRUE(ordered) << "vertex " << i;
+      }
+    }
+    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+      const Vec3i& cell = g.triangle_cell[t];
+      if (t > 0) {
+        ASSERT_FALSE(mc_point_before(cell, g.triangle_cell[t - 1])) << "triangle " << t;
+      }
+      for (const std::uint32_t corner : m.triangles[t]) {
+        const Vec3i d = g.vertex_edge_lower[corner] - cell;
+        const int axis = g.vertex_edge_axis[corner];
+        for (int a = 0; a < 3; ++a) EXPECT_TRUE(d[a] == 0 || (d[a] == 1 && a != axis)) << "triangle " << t;
+      }
+    }
+  }
+}
+
 TEST(MarchingCubes, IntegerTiesGiveNoDegenerateTriangles) {
   // u8-style data: a quantised cone around a centre, so many voxels equal the integer iso-value exactly,
   // plus a flat terrace where a whole plane of voxels equals it.
