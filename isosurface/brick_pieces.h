@@ -2,7 +2,7 @@
 /// \file The marching-cubes mesh of a whole grid assembled from pieces extracted on parts of it (the feature
 /// geometry of `--distribute data`, mpi/distributed_features.h). Key decision: a piece keeps the cells whose
 /// lowest corner its part owns and the vertices whose grid edge starts there, each tagged with that cell or edge;
-/// sorting all pieces' elements by their tags in the extractor's own output order (volume::mc_point_before)
+/// sorting all pieces' elements by their tags in the extractor's own output order (volume::mc_order_key)
 /// reproduces the one-grid mesh bit for bit, so everything built on it (smoothing, simplification, curvature,
 /// lines) equals the one-process result. No MPI here: the pieces travel as bytes.
 #include <array>
@@ -24,10 +24,13 @@ struct PieceVertex {
   Vec3f position;
 };
 
-/// A triangle of the cell with lowest corner `cell`, by its corners' grid edges.
+/// A triangle of the cell with lowest corner `cell`, by its corners' grid edges: each is one of the cell's 12
+/// edges, coded as 4·axis + the edge's offsets (0 or 1) from the cell along the other two axes in increasing order
+/// (bit 0 the first). 16 bytes, a quarter of the edges spelled out.
 struct PieceTriangle {
   std::array<std::int32_t, 3> cell;
-  std::array<std::array<std::int32_t, 4>, 3> corners;  ///< lower x, y, z and axis of each corner's edge
+  std::array<std::uint8_t, 3> corners;
+  std::uint8_t unused = 0;  ///< explicit, so the bytes sent are all defined
 };
 
 struct MeshPiece {
@@ -48,8 +51,9 @@ std::vector<MeshPiece> extract_owned_pieces(const volume::Volume& level, Span<co
 ///        partition, or a precondition above failed).
 TriMesh assemble_pieces(const std::vector<MeshPiece>& pieces);
 
-/// Bytes of a piece, for sending; from_bytes(to_bytes(p)) == p. \throw std::runtime_error on a malformed buffer.
-std::vector<std::uint8_t> to_bytes(const MeshPiece& piece);
-MeshPiece from_bytes(Span<const std::uint8_t> bytes);
+/// Bytes of a rank's pieces (one per surface), for sending; from_bytes(to_bytes(p)) == p.
+/// \throw std::runtime_error on a malformed buffer.
+std::vector<std::uint8_t> to_bytes(const std::vector<MeshPiece>& pieces);
+std::vector<MeshPiece> from_bytes(Span<const std::uint8_t> bytes);
 
 }  // namespace raysift::isosurface

@@ -163,29 +163,39 @@ bool lines_wanted(const sampling::SampledRenderRequest& request) {
   return wants_lines(request.sampling.mode, request.features.classes, request.sampling.budget_ms);
 }
 
-/// The frame's importance on every rank. Without lines: the control from the shared mask, computed on every
-/// rank. With lines: rank 0's lines over the shared mask, broadcast, as --distribute image does; they come from
-/// `request.feature_mesh` (loaded by rank 0: lines need no voxel) or from the bricks
-/// (mpi/distributed_features.h). A TF transparent over the whole data range skips them, as one process does.
-ImageF shared_importance(const Image<std::uint8_t>& background, const volume::RayCaster& caster,
-                         const BrickScene& scene, const sampling::SampledRenderRequest& request,
-                         sampling::SampledRender& out, RankStats& stats) {
+/// Whether the frame's importance has lines (the same on every rank): wanted and not skipped for a TF transparent
+/// over the whole data range (as one process skips them, setting `skipped`).
+bool frame_has_lines(const BrickScene& scene, const sampling::SampledRenderRequest& request, bool& skipped) {
   const bool lines = lines_wanted(request);
-  out.features_skipped = lines && request.feature_mesh.empty() && sampling::transparent_over_data(scene.whole, scene.tf);
-  if (!lines || out.features_skipped)
-    return sampling::frame_importance(background, caster.camera(), nullptr, request.features);
+  skipped = lines && request.feature_mesh.empty() && sampling::transparent_over_data(scene.whole, scene.tf);
+  return lines && !skipped;
+}
+
+/// The feature geometry on rank 0 (nullopt elsewhere): `request.feature_mesh` (lines need no voxel), or built from
+/// the bricks (mpi/distributed_features.h). View-independent set-up, as in one process: not part of the frame.
+std::optional<sampling::FeatureGeometry> root_geometry(const BrickScene& scene, const CameraSpec& camera,
+                                                       const sampling::SampledRenderRequest& request, RankStats& stats) {
   std::optional<sampling::FeatureGeometry> geometry;
   if (request.feature_mesh.empty()) {
     isosurface::FeatureGeometryOptions options = request.geometry;
-    if (!options.view) options.view = isosurface::FeatureView{caster.camera().spec(), request.features.importance.scale};
-    geometry = build_distributed_feature_geometry(scene.plan, scene.brick, scene.whole, scene.tf, options, stats);
+    if (!options.view) options.view = isosurface::FeatureView{camera, request.features.importance.scale};
+    return build_distributed_feature_geometry(scene.plan, scene.brick, scene.whole, scene.tf, options, stats);
   }
+  all_or_none([&] {
+    if (is_root()) geometry = isosurface::load_feature_geometry(request.feature_mesh);
+  });
+  return geometry;
+}
+
+/// The frame's importance on every rank: without lines the control from the shared mask, computed on every rank;
+/// with lines rank 0's over the shared mask, broadcast, as --distribute image does.
+ImageF shared_importance(const Image<std::uint8_t>& background, const volume::RayCaster& caster, bool lines,
+                         const std::optional<sampling::FeatureGeometry>& geometry,
+                         const sampling::SampledRenderRequest& request, RankStats& stats) {
+  if (!lines) return sampling::frame_importance(background, caster.camera(), nullptr, request.features);
   ImageF importance(caster.width(), caster.height());
   all_or_none([&] {
-    if (!is_root()) return;
-    if (!geometry) geometry = isosurface::load_feature_geometry(request.feature_mesh);
-    out.features = sampling::summarize(*geometry);
-    importance = sampling::frame_importance(background, caster.camera(), &*geometry, request.features);
+    if (is_root()) importance = sampling::frame_importance(background, caster.camera(), &*geometry, request.features);
   });
   broadcast_importance(importance, stats);
   return importance;
@@ -208,14 +218,18 @@ DataSampledFrame render_sampled_data_parallel(const BrickScene& scene, const Cam
     sampling::validate(request.sampling);
     caster = std::make_unique<volume::RayCaster>(scene.brick, scene.tf, camera, segment_options(scene.plan, options));
   });
+  bool skipped = false;
+  const bool lines = frame_has_lines(scene, request, skipped);
+  const std::optional<sampling::FeatureGeometry> geometry =
+      lines ? root_geometry(scene, camera, request, stats) : std::nullopt;
   const Timer total;
-  sampling::SampledRender lines;
-  const ImageF importance = shared_importance(shared_background(*caster, stats), *caster, scene, request, lines, stats);
+  const ImageF importance =
+      shared_importance(shared_background(*caster, stats), *caster, lines, geometry, request, stats);
   const std::vector<int> order = visibility_order(scene.plan.split, scene.brick.world_to_index(camera.eye));
   DataSampledFrame frame;
   frame.render = render_sampled_lockstep(importance, total, *caster, request.sampling, background, order, stats);
-  frame.render.features = std::move(lines.features);
-  frame.render.features_skipped = lines.features_skipped;
+  if (geometry) frame.render.features = sampling::summarize(*geometry);
+  frame.render.features_skipped = skipped;
   frame.visible_blocks = std::uint64_t(sum_all(double(caster->visible_block_count())));
   return frame;
 }

@@ -1,6 +1,7 @@
 #include "mpi/distributed_features.h"
 
 #include <cmath>
+#include <stdexcept>
 
 #include "core/errors.h"
 #include "core/timer.h"
@@ -43,23 +44,23 @@ std::vector<double> agreed_iso_values(const volume::Volume& brick, const volume:
   return values;
 }
 
-/// On rank 0: every rank's piece of each surface, assembled. Elsewhere: empty.
+/// On rank 0: every rank's piece of each surface, assembled (one gather). Elsewhere: empty.
 std::vector<TriMesh> gathered_surfaces(const std::vector<isosurface::MeshPiece>& pieces, RankStats& stats) {
-  std::vector<TriMesh> surfaces;
-  for (const isosurface::MeshPiece& piece : pieces) {
-    const std::vector<std::uint8_t> bytes = isosurface::to_bytes(piece);
-    const std::vector<std::vector<std::uint8_t>> all = gather(bytes);
-    if (!is_root()) {
-      stats.bytes_sent += bytes.size();
-      continue;
-    }
-    std::vector<isosurface::MeshPiece> received;
-    for (std::size_t r = 0; r < all.size(); ++r) {
-      received.push_back(isosurface::from_bytes(all[r]));
-      if (r != 0) stats.bytes_received += all[r].size();
-    }
-    surfaces.push_back(isosurface::assemble_pieces(received));
+  const std::vector<std::uint8_t> bytes = isosurface::to_bytes(pieces);
+  const std::vector<std::vector<std::uint8_t>> all = gather(bytes);
+  if (!is_root()) {
+    stats.bytes_sent += bytes.size();
+    return {};
   }
+  std::vector<std::vector<isosurface::MeshPiece>> by_surface(pieces.size());
+  for (std::size_t r = 0; r < all.size(); ++r) {
+    std::vector<isosurface::MeshPiece> received = isosurface::from_bytes(all[r]);
+    if (received.size() != pieces.size()) throw std::logic_error("mesh pieces: ranks disagree on the surface count");
+    for (std::size_t i = 0; i < received.size(); ++i) by_surface[i].push_back(std::move(received[i]));
+    if (r != 0) stats.bytes_received += all[r].size();
+  }
+  std::vector<TriMesh> surfaces;
+  for (const std::vector<isosurface::MeshPiece>& surface : by_surface) surfaces.push_back(isosurface::assemble_pieces(surface));
   return surfaces;
 }
 

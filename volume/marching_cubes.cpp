@@ -635,12 +635,9 @@ TriMesh extract(const openvdb::FloatGrid& grid, const BlockSet& blocks, double i
 
 }  // namespace
 
-bool mc_point_before(const Vec3i& a, const Vec3i& b) {
-  const std::uint64_t ka = block_key(openvdb::Coord(a.x, a.y, a.z) & ~(kB - 1)),
-                      kb = block_key(openvdb::Coord(b.x, b.y, b.z) & ~(kB - 1));
-  if (ka != kb) return ka < kb;
-  const int la[3] = {a.x & (kB - 1), a.y & (kB - 1), a.z & (kB - 1)}, lb[3] = {b.x & (kB - 1), b.y & (kB - 1), b.z & (kB - 1)};
-  return std::lexicographical_compare(la, la + 3, lb, lb + 3);
+McOrderKey mc_order_key(const Vec3i& point, int axis) {
+  const int x = point.x & (kB - 1), y = point.y & (kB - 1), z = point.z & (kB - 1);
+  return {block_key(openvdb::Coord(point.x, point.y, point.z) & ~(kB - 1)), std::uint32_t(edge_id(x, y, z, axis))};
 }
 
 std::vector<TriMesh> extract_isosurfaces(const Volume& volume, Span<const double> iso_values,

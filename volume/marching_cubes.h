@@ -30,10 +30,17 @@ struct McOrigins {
   std::vector<Vec3i> triangle_cell;
 };
 
-/// The output order of index points: by 8³ block in (z, y, x) order of the block, then (x, y, z) within the
-/// block. Vertices come in the order of (lower end point, axis), triangles in the order of their cell (a cell's
-/// triangles in table order), so sorting pieces by these keys reproduces the whole grid's output.
-bool mc_point_before(const Vec3i& a, const Vec3i& b);
+/// The output order as a sortable key: by 8³ block in (z, y, x) order of the block, then by the point's (x, y, z)
+/// within the block, then by axis. Vertices come in the order of the key of (lower end point, axis), triangles in
+/// the order of the key of (their cell, 0) with a cell's triangles in table order, so sorting pieces by these keys
+/// reproduces the whole grid's output.
+struct McOrderKey {
+  std::uint64_t block = 0;
+  std::uint32_t local = 0;
+  bool operator<(const McOrderKey& o) const { return block < o.block || (block == o.block && local < o.local); }
+  bool operator==(const McOrderKey& o) const { return block == o.block && local == o.local; }
+};
+McOrderKey mc_order_key(const Vec3i& point, int axis = 0);
 
 struct MarchingCubesOptions {
   /// Default: triangles are counter-clockwise seen from the side with values below the iso-value, i.e.

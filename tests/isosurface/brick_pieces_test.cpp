@@ -110,13 +110,17 @@ TEST_F(BrickPieces, RegionHistogramsAddUpToTheWholeGridHistogram) {
 }
 
 TEST_F(BrickPieces, BytesRoundTripAndRejectATruncatedBuffer) {
-  const MeshPiece piece = extract_owned_pieces(whole_, std::vector<double>{0.3}, regions()[1]).front();
-  ASSERT_FALSE(piece.vertices.empty());
-  std::vector<std::uint8_t> bytes = to_bytes(piece);
-  const MeshPiece back = from_bytes(bytes);
+  const std::vector<MeshPiece> pieces = extract_owned_pieces(whole_, std::vector<double>{0.3, 0.6}, regions()[1]);
+  ASSERT_FALSE(pieces[1].vertices.empty());
+  std::vector<std::uint8_t> bytes = to_bytes(pieces);
+  const std::vector<MeshPiece> back = from_bytes(bytes);
+  ASSERT_EQ(back.size(), 2u);
   EXPECT_EQ(to_bytes(back), bytes);
   bytes.pop_back();
   EXPECT_THROW(from_bytes(bytes), std::runtime_error);
+  bytes.push_back(0);
+  bytes.push_back(0);
+  EXPECT_THROW(from_bytes(bytes), std::runtime_error);  // trailing byte
 }
 
 TEST_F(BrickPieces, OverlappingOrMissingPiecesAreLogicErrors) {

@@ -216,7 +216,7 @@ TEST(MarchingCubes, RandomFieldIsAClosedManifold) {
 
 TEST(MarchingCubes, OriginsNameEachVertexEdgeAndTriangleCellInOutputOrder) {
   // The tags brick assembly sorts by (isosurface/brick_pieces.h): each vertex lies on its tagged edge, each
-  // triangle's corners on edges of its tagged cell, and both sequences are already in mc_point_before order.
+  // triangle's corners on edges of its tagged cell, and both sequences are already in mc_order_key order.
   // Negative indices and a sheared transform included.
   DenseSpec spec;
   spec.dims = {40, 36, 30};
@@ -252,14 +252,13 @@ TEST(MarchingCubes, OriginsNameEachVertexEdgeAndTriangleCellInOutputOrder) {
       }
       if (i > 0) {
         const Vec3i& prev = g.vertex_edge_lower[i - 1];
-        const bool ordered = mc_point_before(prev, lo) || (prev == lo && g.vertex_edge_axis[i - 1] < axis);
-        ASSERT_TRUE(ordered) << "vertex " << i;
+        ASSERT_TRUE(mc_order_key(prev, g.vertex_edge_axis[i - 1]) < mc_order_key(lo, axis)) << "vertex " << i;
       }
     }
     for (std::size_t t = 0; t < m.triangle_count(); ++t) {
       const Vec3i& cell = g.triangle_cell[t];
       if (t > 0) {
-        ASSERT_FALSE(mc_point_before(cell, g.triangle_cell[t - 1])) << "triangle " << t;
+        ASSERT_FALSE(mc_order_key(cell) < mc_order_key(g.triangle_cell[t - 1])) << "triangle " << t;
       }
       for (const std::uint32_t corner : m.triangles[t]) {
         const Vec3i d = g.vertex_edge_lower[corner] - cell;
