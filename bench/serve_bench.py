@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """raysift serve under a scripted drag (issue 18 benchmark): a 10-s orbit of the bundled engine CT at 960x600, camera
-messages at 60 Hz (a mouse drag), at target rates of 5, 10 and 20 fps. Per rate: the server's frame render time
-(p50/p95, the budgeted quantity), render+encode+send (p50/p95, from --stats), the achieved rate of frames that
-reflect a drag camera, latency from a camera message to its first frame arriving, and the mean SSIM_object of the
+messages as the page sends them (one in flight; --pacing 60hz: a raw 60 Hz mouse stream), at target rates of 5, 10
+and 20 fps. Per rate: the server's frame render time (p50/p95, the budgeted quantity), render+encode+send (p50/p95,
+from --stats), the achieved rate of frames that reflect a drag camera, the latency from every camera message to the
+first frame arriving that reflects it or a later one (and of the frames' own messages), and the mean SSIM_object of the
 received frames against the full render of the same cameras. The drag starts once the viewer's feature geometry is
 built (features_ready). The full renders are of a subset of the frames
 (--compare evenly spaced frames per rate) through raysift.Renderer, the CLI's code path (apps/raysift/render_session),
@@ -40,6 +41,10 @@ def parse_args():
     p.add_argument("--height", type=int, default=600)
     p.add_argument("--format", choices=["png", "jpeg"], default="png")
     p.add_argument("--compare", type=int, default=12, help="frames per rate compared with a full render")
+    p.add_argument("--pacing", choices=["flow", "60hz"], default="flow",
+                   help="flow: the next camera message once a frame header reflects the last one and a frame period "
+                        "has passed since it was sent (as the page does); 60hz: a message every 1/60 s whatever the "
+                        "frames (a raw mouse stream)")
     p.add_argument("--json", default="", help="also write the results here")
     return p.parse_args()
 
@@ -56,17 +61,21 @@ def start_server(exe, scene, fps, stats_path):
 
 
 def orbit_camera(hello_camera, t, seconds, width, height):
-    """One turn about the vertical axis through the target, at the default view's distance, in `seconds`."""
-    eye, target = np.array(hello_camera["eye"]), np.array(hello_camera["target"])
-    radius = np.linalg.norm(eye - target)
+    """One turn about the default view's up axis through the target, at its distance, in `seconds` (Rodrigues'
+    rotation of the eye; at t = 0 the default view)."""
+    eye, target = np.array(hello_camera["eye"], float), np.array(hello_camera["target"], float)
+    axis = np.array(hello_camera["up"], float)
+    axis /= np.linalg.norm(axis)
     angle = 2 * math.pi * t / seconds
-    new_eye = target + radius * np.array([math.sin(angle), 0.0, math.cos(angle)])
-    return {"eye": new_eye.tolist(), "target": target.tolist(), "up": hello_camera["up"],
+    v = eye - target
+    rotated = v * math.cos(angle) + np.cross(axis, v) * math.sin(angle) + axis * np.dot(axis, v) * (1 - math.cos(angle))
+    return {"eye": (target + rotated).tolist(), "target": target.tolist(), "up": hello_camera["up"],
             "fov_y_deg": hello_camera["fov_y_deg"], "width": width, "height": height}
 
 
-def receive(ws, frames, stop):
-    """Frames (arrival time, header, image bytes) until `stop` is set and the socket times out."""
+def receive(ws, frames, stop, answered):
+    """Frames (arrival time, header, image bytes) until `stop` is set and the socket times out; answered(camera_seq)
+    at each frame header."""
     header = None
     while not stop.is_set():  # refinement frames may keep coming long after the drag
         try:
@@ -81,7 +90,11 @@ def receive(ws, frames, stop):
             header = None
             continue
         j = json.loads(m)
+        if j.get("type") == "error":  # a camera the server rejects would silently leave a gap in the drag
+            raise SystemExit("serve_bench: the server answered: " + j.get("message", ""))
         header = j if j.get("type") == "frame" else None
+        if header is not None and header.get("camera_seq") is not None:
+            answered(header["camera_seq"])
 
 
 def drag(port, args, fps):
@@ -97,7 +110,15 @@ def drag(port, args, fps):
     features_ms = (time.perf_counter() - built) * 1000
     ws.settimeout(0.5)
     frames, sent, stop = [], {}, threading.Event()
-    receiver = threading.Thread(target=receive, args=(ws, frames, stop))
+    reflected = {"seq": 0}
+    answer = threading.Condition()
+
+    def answered(camera_seq):
+        with answer:
+            reflected["seq"] = max(reflected["seq"], camera_seq)
+            answer.notify()
+
+    receiver = threading.Thread(target=receive, args=(ws, frames, stop, answered))
     receiver.start()
     start = time.perf_counter()
     seq = 0
@@ -106,7 +127,12 @@ def drag(port, args, fps):
         camera = orbit_camera(hello["camera"], now - start, args.seconds, args.width, args.height)
         sent[seq] = (time.perf_counter(), camera)
         ws.send(json.dumps(dict(camera, type="camera", seq=seq)))
-        time.sleep(max(0.0, start + seq / 60.0 - time.perf_counter()))
+        if args.pacing == "flow":  # as the page: one message in flight (unless unanswered for 1 s), one per period
+            with answer:
+                answer.wait_for(lambda: reflected["seq"] >= seq, timeout=1.0)
+            time.sleep(max(0.0, sent[seq][0] + 1.0 / fps - time.perf_counter()))
+        else:
+            time.sleep(max(0.0, start + seq / 60.0 - time.perf_counter()))
     drag_end = time.perf_counter()
     time.sleep(1.0)  # the last frames of the drag arrive
     stop.set()
@@ -138,9 +164,13 @@ def percentile(values, p):
 
 def evaluate(renderer, sent, frames, drag_end, args, tmp):
     in_drag = [(t, h, img) for t, h, img in frames if h["camera_seq"] is not None and t <= drag_end + 1e-3]
-    latency = {}
+    latency, reflected = {}, {}  # every message -> the first frame reflecting it or a later one; the frames' own
+    waiting = sorted(sent)
     for t, h, _ in in_drag:
-        latency.setdefault(h["camera_seq"], (t - sent[h["camera_seq"]][0]) * 1000)
+        reflected.setdefault(h["camera_seq"], (t - sent[h["camera_seq"]][0]) * 1000)
+        while waiting and waiting[0] <= h["camera_seq"]:
+            latency[waiting[0]] = (t - sent[waiting[0]][0]) * 1000
+            waiting.pop(0)
     step = max(1, len(in_drag) // args.compare)
     ssim, full_ms = [], []
     for t, h, img in in_drag[::step][:args.compare]:
@@ -157,7 +187,8 @@ def evaluate(renderer, sent, frames, drag_end, args, tmp):
             "render_ms_p50": percentile(ms, 0.5), "render_ms_p95": percentile(ms, 0.95),
             "interval_ms_p50": percentile([1000 * (b - a) for a, b in zip(arrivals, arrivals[1:])], 0.5),
             "latency_ms_p50": percentile(list(latency.values()), 0.5),
-            "latency_ms_p95": percentile(list(latency.values()), 0.95),
+            "latency_ms_p95": percentile(list(latency.values()), 0.95), "messages": len(sent),
+            "reflected_latency_ms_p95": percentile(list(reflected.values()), 0.95),
             "ray_fraction_mean": statistics.mean(h["rays_traced"] / h["full_rays"] for _, h, _ in in_drag),
             "budget_ms_mean": statistics.mean(h["budget_ms"] for _, h, _ in in_drag),
             "ssim_object_mean": statistics.mean(ssim), "compared": len(ssim),
@@ -187,10 +218,12 @@ def main():
             r.update(features_ready_ms=features_ms, total_ms_p50=server.get("total_p50"), total_ms_p95=server.get("total_p95"), load=load,
                      target_ms=1000 / fps, frame_over_full=r["render_ms_p50"] / r["full_render_ms_p50"])
             results[fps] = r
-            print(f"target {fps:g} fps ({args.format}, load {load:.1f}): achieved {r['achieved_fps']:.2f} fps, "
+            print(f"target {fps:g} fps ({args.format}, {args.pacing}, load {load:.1f}): achieved {r['achieved_fps']:.2f} fps, "
                   f"render p50/p95 {r['render_ms_p50']:.1f}/{r['render_ms_p95']:.1f} ms (budget mean "
                   f"{r['budget_ms_mean']:.1f}), render+encode+send p50/p95 {r['total_ms_p50']:.1f}/"
-                  f"{r['total_ms_p95']:.1f} ms, latency p50/p95 {r['latency_ms_p50']:.1f}/{r['latency_ms_p95']:.1f} ms"
+                  f"{r['total_ms_p95']:.1f} ms, latency p50/p95 {r['latency_ms_p50']:.1f}/{r['latency_ms_p95']:.1f} ms over "
+                  f"{r['messages']} messages ({r['latency_ms_p95'] * fps / 1000:.2f}x the period; reflected p95 "
+                  f"{r['reflected_latency_ms_p95']:.1f})"
                   f", rays {100 * r['ray_fraction_mean']:.1f}%, SSIM_object {r['ssim_object_mean']:.4f} over "
                   f"{r['compared']} frames; full render p50 {r['full_render_ms_p50']:.1f} ms (frame/full "
                   f"{r['frame_over_full']:.2f}); features ready after {features_ms:.0f} ms", flush=True)

@@ -67,10 +67,9 @@ RenderedFrame FrameRenderer::full_frame(const FrameRequest& request, double setu
 }
 
 std::optional<double> FrameRenderer::full_ms(const FrameRequest& request) const {
-  if (!full_cost_ || full_cost_->width != request.camera.width || full_cost_->height != request.camera.height ||
-      full_cost_->render != request.render)
-    return std::nullopt;
-  return full_cost_->ms;
+  if (!full_cost_ || full_cost_->render != request.render) return std::nullopt;
+  const double pixels = double(request.camera.width) * double(request.camera.height);
+  return full_cost_->ms * pixels / (double(full_cost_->width) * double(full_cost_->height));
 }
 
 RenderedFrame FrameRenderer::first_frame(const FrameRequest& request) {

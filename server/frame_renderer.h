@@ -47,7 +47,7 @@ class FrameRenderer {
   /// \throw InvalidInput for a bad camera; Cancelled.
   RenderedFrame first_frame(const FrameRequest& request);
   /// The next refinement frame of the view of the last first_frame(): the prioritized queue continued within the
-  /// budget (or one full render when the full-frame time of this size and TF is not yet measured: that measures
+  /// budget (or one full render when no full-frame time of this TF is known yet: that measures
   /// it); the other modes finish with one full render. \pre !converged().
   RenderedFrame refine(const FrameRequest& request);
   bool converged() const { return converged_; }
@@ -55,10 +55,12 @@ class FrameRenderer {
  private:
   /// \param supersedable also stop when the view changed (refinement frames).
   RenderedFrame full_frame(const FrameRequest& request, double setup_ms, bool supersedable);
-  /// The measured full-frame time (set-up + trace + compositing) of the request's size and TF, if known.
+  /// The full-frame time (set-up + trace + compositing) of the request's TF, if one was measured: of the last
+  /// measured size, scaled by the pixel count to the request's [choice: rays and samples scale with the pixels of
+  /// one view; a drag never refines, so a new size would otherwise never learn its cost].
   std::optional<double> full_ms(const FrameRequest& request) const;
 
-  /// The last full frame's cost; a new size or TF forgets it (one key: a session renders one view at a time).
+  /// The last full frame's cost; a new TF forgets it (one key: a session renders one view at a time).
   struct FullCost {
     int width = 0, height = 0;
     const app::RenderSession* render = nullptr;

@@ -200,8 +200,13 @@ void ViewerSession::bump_version() {
   latest_version_.store(view_.version, std::memory_order_relaxed);
 }
 
-bool ViewerSession::next_view(std::uint64_t rendered, bool converged, View& view) {
+bool ViewerSession::next_view(std::uint64_t rendered, bool converged,
+                              std::chrono::steady_clock::time_point refine_after, View& view) {
   std::unique_lock<std::mutex> lock(mutex_);
+  // During a drag the next camera comes soon after a frame is sent (the page sends it when the frame arrives). A
+  // refinement started meanwhile would delay that camera's frame by up to a budget (it is not cancelled
+  // mid-frame), so refinement waits until a period has passed since the view's last new frame was sent.
+  cv_.wait_until(lock, refine_after, [&] { return stopping_ || view_.version != rendered; });
   cv_.wait(lock, [&] { return stopping_ || view_.version != rendered || !converged; });
   if (stopping_) return false;
   view = view_;
@@ -219,8 +224,9 @@ void ViewerSession::render_loop() {
   double overhead_ms = 0;  // encode + send of the last frame, taken off the next budget
   double overrun_ms = 0;   // by how much budgeted renders exceed their budget, also taken off: the latency target
   auto next_start = std::chrono::steady_clock::now();
+  auto refine_after = next_start;
   View view;
-  while (next_view(rendered, renderer.converged(), view)) {
+  while (next_view(rendered, renderer.converged(), refine_after, view)) {
     const bool is_new = view.version != rendered;
     const double period_ms = 1000.0 / view.settings.target_fps;
     if (is_new) {  // a drag gets frames at the target rate, not faster: wait out the period, then take the latest
@@ -248,6 +254,8 @@ void ViewerSession::render_loop() {
       const Timer send;
       if (!send_frame(frame, view, view.settings.mode == "full" ? 0.0 : budget_ms)) return;
       const double sent_ms = send.elapsed_ms();
+      // A drag's next camera comes when the page has this frame: refinement waits a period for it.
+      if (is_new) refine_after = std::chrono::steady_clock::now() + std::chrono::microseconds(std::int64_t(period_ms * 1000));
       overhead_ms = 0.5 * (overhead_ms + sent_ms);  // smoothed: one slow send does not halve a budget
       if (is_new && view.settings.mode == "prioritized" && !frame.converged)
         // Capped: when the fixed costs alone exceed the budget, a smaller budget only loses rays, not time.

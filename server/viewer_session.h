@@ -3,6 +3,7 @@
 /// hello, frame + image, tf_applied, features_ready and error out), its own camera, TF and settings, a render
 /// thread and a feature-geometry thread.
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <memory>
@@ -67,8 +68,10 @@ class ViewerSession : public ConnectionHandler {
   Json hello() const;
   void render_loop();
   void geometry_loop();
-  /// Waits until the view changed, refinement is pending, or the session stops (then false).
-  bool next_view(std::uint64_t rendered, bool converged, View& view);
+  /// Waits until the view changed, refinement is pending (not before `refine_after`), or the session stops
+  /// (then false).
+  bool next_view(std::uint64_t rendered, bool converged, std::chrono::steady_clock::time_point refine_after,
+                 View& view);
   bool superseded(std::uint64_t version);
   void bump_version();  ///< \pre mutex_ held
   bool send_frame(const RenderedFrame& frame, const View& view, double budget_ms);

@@ -17,7 +17,8 @@ const ZOOM_STEP = 1.1;
 const MODES = ["prioritized", "full", "subsample"];
 
 const state = {
-  volume: null, camera: null, seq: 0, camera_scheduled: false, last_camera: null,
+  volume: null, camera: null, seq: 0, camera_dirty: false, camera_timer: null, camera_sent_at: -Infinity,
+  last_camera: null,
   settings: null, tf: null, home_tf: null, last_tf_preset: null, tf_timer: null, tf_pending: false,
   tf_sent: 0, tf_applied: 0, iso_values: [], features_ready: null, errors: [], sub: null,
 };
@@ -26,6 +27,7 @@ const editor = new TfEditor($("tf-canvas"), (tf, is_final) => { state.tf = tf; s
 const main_session = new Session(WS_URL, $("main-canvas"), {
   hello: on_hello,
   frame: () => update_labels(),
+  camera_answered: () => pump_camera(),  // the main view's last camera is rendered: the next may go
   tf_applied: (msg) => {
     state.tf_applied += 1;
     state.features_ready = !!msg.features_ready;
@@ -87,15 +89,31 @@ function render_size() {
   return [Math.max(16, Math.round(w * s)), Math.max(16, Math.round(h * s))];
 }
 
+/// The camera changed: it goes out through pump_camera().
 function schedule_camera() {
-  if (!state.camera || state.camera_scheduled) return;
-  state.camera_scheduled = true;
-  requestAnimationFrame(send_camera);
+  if (!state.camera) return;
+  state.camera_dirty = true;
+  pump_camera();
 }
 
-/// At most one camera message per displayed frame; both sessions get the same message.
+/// Flow control and pacing [choice]: the newest camera goes out when none is in flight (the last one's frame header
+/// arrived, Session.camera_in_flight) and a frame period has passed since the last one went. So the server never
+/// holds a queued camera behind a frame, and a message carries the mouse position of its own send time rather than
+/// one a period old (docs/serve-page.md, "Latency").
+function pump_camera() {
+  if (!state.camera_dirty || state.camera_timer !== null || main_session.camera_in_flight()) return;
+  const period_ms = state.settings ? 1000 / state.settings.target_fps : 0;
+  const wait_ms = Math.max(0, state.camera_sent_at + period_ms - performance.now());
+  state.camera_timer = setTimeout(() => {
+    state.camera_timer = null;
+    if (state.camera_dirty && !main_session.camera_in_flight()) send_camera();
+  }, wait_ms);
+}
+
+/// Both sessions get the same message.
 function send_camera() {
-  state.camera_scheduled = false;
+  state.camera_dirty = false;
+  state.camera_sent_at = performance.now();
   const [w, h] = render_size();
   state.seq += 1;
   state.last_camera = state.camera.message(w, h, state.seq);
@@ -212,6 +230,7 @@ function set_split(on) {
         if (state.last_camera) sub.send(state.last_camera);
       },
       frame: () => update_labels(),
+  camera_answered: () => pump_camera(),  // the main view's last camera is rendered: the next may go
       error: (text) => show_message(`server (subsample view): ${text}`, true),
       closed: (text) => { $("sub-label").textContent = `subsample: ${text}`; },
     });

@@ -4,6 +4,7 @@
 
 const RATE_WINDOW_MS = 1000;
 const LATENCY_KEEP = 500;
+const CAMERA_ANSWER_WAIT_MS = 1000;  // a camera message unanswered this long no longer holds the next one back
 
 export function percentile(values, p) {
   if (values.length === 0) return null;
@@ -20,13 +21,15 @@ function latency_summary(values) {
 }
 
 export class Session {
-  /// handlers: hello(msg), frame(meta), tf_applied(msg), features_ready(), error(text), closed(text).
+  /// handlers: hello(msg), frame(meta), camera_answered(), tf_applied(msg), features_ready(), error(text),
+  /// closed(text).
   constructor(url, canvas, handlers) {
     this.canvas = canvas;
     this.handlers = handlers;
     this.pending_meta = null;
     this.draw_chain = Promise.resolve();
     this.sent_camera = new Map();    // seq -> performance.now() when sent, until a frame reflects it
+    this.in_flight = null;           // {seq, sent} of the last camera message until a frame header reflects it
     this.latencies_ms = [];          // camera message -> first pixels drawn that reflect it
     this.reflected_latencies_ms = []; // the same, only for the message each frame was rendered from
     this.draw_times = [];            // performance.now() of recent draws, for the achieved rate
@@ -43,8 +46,19 @@ export class Session {
 
   send(message) {
     if (!this.is_open()) return;
-    if (message.type === "camera" && message.seq !== undefined) this.sent_camera.set(message.seq, performance.now());
+    if (message.type === "camera" && message.seq !== undefined) {
+      const now = performance.now();
+      this.sent_camera.set(message.seq, now);
+      this.in_flight = { seq: message.seq, sent: now };
+    }
     this.ws.send(JSON.stringify(message));
+  }
+
+  /// Flow control [choice]: one camera message in flight. The page sends the next camera when a frame header
+  /// reflects the last one (handlers.camera_answered), so the server never holds a queued camera behind a frame
+  /// (each message's latency is then one frame, not up to two: docs/serve-page.md).
+  camera_in_flight() {
+    return this.in_flight !== null && performance.now() - this.in_flight.sent < CAMERA_ANSWER_WAIT_MS;
   }
 
   close() { this.ws.onclose = null; this.ws.close(); }
@@ -55,7 +69,13 @@ export class Session {
     try { msg = JSON.parse(data); } catch { return this.handlers.error?.("unreadable message from the server"); }
     switch (msg.type) {
       case "hello": return this.handlers.hello?.(msg);
-      case "frame": this.pending_meta = msg; return;
+      case "frame":
+        this.pending_meta = msg;
+        if (this.in_flight && typeof msg.camera_seq === "number" && msg.camera_seq >= this.in_flight.seq) {
+          this.in_flight = null;
+          this.handlers.camera_answered?.();
+        }
+        return;
       case "tf_applied": return this.handlers.tf_applied?.(msg);
       case "features_ready": return this.handlers.features_ready?.();
       case "error": return this.handlers.error?.(msg.message);
@@ -106,6 +126,7 @@ export class Session {
       if (seq > camera_seq) continue;
       this.latencies_ms.push(now - sent);
       if (seq === camera_seq) this.reflected_latencies_ms.push(now - sent);
+      if (this.drag && this.drag.active && seq >= this.drag.first_seq) this.drag.latencies_ms.push(now - sent);
       this.sent_camera.delete(seq);
     }
     for (const list of [this.latencies_ms, this.reflected_latencies_ms])
@@ -113,7 +134,9 @@ export class Session {
   }
 
   /// A drag's frame rate counts the frames that reflect its camera messages, from the first to its end.
-  begin_drag(first_seq) { this.drag = { active: true, first_seq, draws: [], frame_ms: [], budget_ms: [] }; }
+  begin_drag(first_seq) {
+    this.drag = { active: true, first_seq, draws: [], frame_ms: [], budget_ms: [], latencies_ms: [] };
+  }
   end_drag() { if (this.drag) this.drag.active = false; }
 
   stats() {
@@ -147,6 +170,7 @@ export class Session {
       fps: t.length >= 2 ? ((t.length - 1) * 1000) / (t[t.length - 1] - t[0]) : null,
       interval_p50_ms: percentile(intervals, 50), interval_p95_ms: percentile(intervals, 95),
       frame_ms_p50: percentile(this.drag.frame_ms, 50), budget_ms_p50: percentile(this.drag.budget_ms, 50),
+      frame_ms_p95: percentile(this.drag.frame_ms, 95), latency_ms: latency_summary(this.drag.latencies_ms),
     };
   }
 }
