@@ -20,6 +20,7 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
+#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -121,6 +122,7 @@ struct Setup {
   bool budget_only = false;  ///< only the budget table (engine opaque)
   int orbit_frames = 60;     ///< frames of each scene's orbit; 0 = no orbit
   bool orbit_only = false;   ///< only the orbit figures
+  std::string orbit_csv;     ///< non-empty: every orbit frame's times, rays, alpha00 and SSIM_object appended here
 };
 
 struct Scene {
@@ -168,6 +170,20 @@ void print_orbit(const std::vector<sampling::PathFrame>& frames, const std::vect
               frames.size(), target_ms, full_ms, percentile(times, 0.5), p95, p95 / target_ms,
               100 * sampling::summarize_path(frames, target_fps).within_10pct_of_target, ssim / n, worst_ssim,
               ssim_linear / n, flip / n, rays / n, lines_skipped);
+}
+
+// Per-frame orbit rows (where the p95 tail comes from): appended, with a header when the file is new.
+void write_orbit_csv(const std::string& path, const std::string& scene, const std::vector<sampling::PathFrame>& frames,
+                     const std::vector<Error>& errors, double target_fps) {
+  const bool fresh = !std::ifstream(path).good();
+  std::ofstream out(path, std::ios::app);
+  if (fresh) out << "scene,frame,ms,target_ms,importance_ms,trace_ms,other_ms,rays_traced,full_rays,alpha00,ssim_object\n";
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const sampling::PathFrame& f = frames[i];
+    out << '"' << scene << "\"," << f.index << ',' << f.ms << ',' << 1000.0 / target_fps << ',' << f.importance_ms << ','
+        << f.trace_ms << ',' << f.ms - f.importance_ms - f.trace_ms << ',' << f.rays_traced << ',' << f.full_rays
+        << ',' << f.alpha00 << ',' << 1 - errors[i].dssim << '\n';
+  }
 }
 
 // One scene's view with its full render and importance buffers; each table is one member function.
@@ -342,6 +358,7 @@ struct SceneRun {
           errors.push_back(error_of(volume::render_full(reference).image, image));
         });
     print_orbit(frames, errors, options.target_fps, full_now);
+    if (!setup.orbit_csv.empty()) write_orbit_csv(setup.orbit_csv, scene.label, frames, errors, options.target_fps);
   }
 };
 
@@ -402,9 +419,10 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--max-budget-share") && more) setup.features.max_budget_share = std::stod(argv[++i]);
     else if (!std::strcmp(argv[i], "--orbit-only")) setup.orbit_only = true;
     else if (!std::strcmp(argv[i], "--orbit-frames") && more) setup.orbit_frames = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--orbit-csv") && more) setup.orbit_csv = argv[++i];
     else {
       std::fprintf(stderr, "usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--linear] [--floor F] "
-                           "[--line-weight W] [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N] [--budget-only] [--spacing S] [--max-budget-share K] [--orbit-only] [--orbit-frames N]\n");
+                           "[--line-weight W] [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N] [--budget-only] [--spacing S] [--max-budget-share K] [--orbit-only] [--orbit-frames N] [--orbit-csv FILE]\n");
       return 2;
     }
   }

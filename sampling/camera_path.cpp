@@ -1,6 +1,7 @@
 #include "sampling/camera_path.h"
 
 #include <algorithm>
+#include <limits>
 #include <array>
 #include <atomic>
 #include <cmath>
@@ -337,11 +338,9 @@ std::optional<FrameRateController> make_controller(const PathRenderOptions& opti
   if (mode != SamplingMode::Prioritized)
     throw InvalidInput("a target frame rate needs the prioritized mode, got " + std::string(sampling_mode_name(mode)));
   if (options.sampling.budget_ms > 0)
-    throw InvalidInput("a target frame rate adapts alpha00 and cannot be combined with a per-frame time budget; give one");
+    throw InvalidInput("a target frame rate sets each frame's ray count and cannot be combined with a per-frame time budget; give one");
   FrameRateOptions fo;
   fo.target_fps = options.target_fps;
-  fo.threshold = std::isfinite(options.sampling.threshold) ? options.sampling.threshold : fo.threshold;
-  fo.initial_alpha00 = options.sampling.mapping.alpha[0];
   return FrameRateController(fo);  // validates target_fps
 }
 
@@ -356,6 +355,7 @@ struct PathState {
   ImageF still_importance;  // importance of the first frame since the camera stopped
   LinesCost lines_cost;     // fitted to the path's frames with lines
   float alpha00;
+  std::size_t rays = 0;     // target-fps: the last frame's ray count (new and reused rays)
   int still_frames = 0;     // frames since the camera stopped, after the first
   FrameTiming last_timing;
 
@@ -377,18 +377,20 @@ ImageRGBA full_frame(const volume::RayCaster& caster, PathState& st, PathFrame& 
   return std::move(r.image);
 }
 
-/// A prioritized frame's selection: α00 from the controller, or, for a still camera, a superset of the frame
-/// before (a threshold frame raises α00, a fraction frame adds another fraction).
+/// A prioritized frame's selection: the controller's ray count (the highest-priority rays, without refinement:
+/// the count is the time budget), or, for a still camera, a superset of the frame before (a threshold frame
+/// raises α00, a fraction frame adds another fraction; a larger top count contains the smaller one).
 SamplingOptions prioritized_options(PathState& st, const PathFrame& frame) {
   SamplingOptions so = st.options.sampling;
   if (st.controller) {
-    if (!st.frames.empty())
-      st.alpha00 = st.controller->update(
-          st.last_timing, RayCountCurve(st.still_importance, *st.pattern, so.mapping, st.controller->threshold()),
-          frame.refined ? st.cache->traced : 0);
-    if (frame.refined) st.alpha00 = std::max(st.alpha00, st.frames.back().alpha00);
-    so.threshold = st.controller->threshold();
-    so.mapping.alpha[0] = st.alpha00;
+    const ObjectCounts counts = count_object_pixels(st.still_importance, *st.pattern);
+    std::size_t rays = st.frames.empty() ? counts.level0  // no cost known yet
+                                         : st.controller->update(st.last_timing, counts, frame.refined ? st.cache->traced : 0);
+    if (frame.refined) rays = std::max(rays, st.rays);
+    st.rays = rays;
+    so.threshold = std::numeric_limits<float>::quiet_NaN();
+    so.refinement.enabled = false;
+    so.ray_fraction = counts.object > 0 ? std::min(1.0, double(std::max<std::size_t>(rays, 1)) / double(counts.object)) : 1.0;
   } else if (frame.refined) {
     if (std::isfinite(so.threshold))
       so.mapping.alpha[0] = st.alpha00 = st.frames.back().alpha00 + kRefineStep;

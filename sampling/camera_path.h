@@ -107,7 +107,7 @@ struct PathFrame {
   std::size_t rays_traced = 0;  ///< rays this frame traced (a still camera's reused rays are not counted)
   std::uint64_t samples = 0;    ///< volume samples taken by those rays (as a single render's `samples`)
   std::size_t full_rays = 0;    ///< rays of the full render of this view
-  float alpha00 = 0;            ///< α00 used (target-fps: the controller's choice)
+  float alpha00 = 0;            ///< α00 of the mapping used (a target rate sets the ray count instead)
   bool refined = false;         ///< same camera as before: previous rays kept, refinement continued
   /// The frame time (1000 / target_fps, or the budget) left no room for the lines (lines_fit_budget).
   bool lines_skipped = false;

@@ -45,7 +45,7 @@ void check_path_flags(PathCliOptions& p, RenderCliOptions& o) {
   if (p.target_fps > 0 && o.mode != "prioritized")
     throw UsageError("--target-fps needs --mode prioritized, got --mode " + o.mode + "; see --help");
   if (p.target_fps > 0 && o.budget_ms > 0)
-    throw UsageError("--target-fps adapts alpha00 and cannot be combined with --budget-ms; give one; see --help");
+    throw UsageError("--target-fps sets each frame's ray count and cannot be combined with --budget-ms; give one; see --help");
   if (!sampling::is_frame_pattern(o.out))
     bad_flag("-o/--out", "a frame pattern such as frame_%03d.png with --camera-path", o.out);
   if (o.progressive > 0 || !o.pixel.empty())
@@ -119,7 +119,7 @@ void add_render_options(CLI::App& sub, RenderCliOptions& o, PathCliOptions& p, c
       "--camera-path", p.camera_path,
       "render a sequence: JSON list of cameras, {\"cameras\": [...]} or {\"orbit\": {centre, radius, "
       "elevation_deg, frames}}; -o is then a pattern such as frame_%03d.png; --features may add saliency");
-  path_group->add_option("--target-fps", p.target_fps, "prioritized: adapt alpha00 to hold this frame rate")
+  path_group->add_option("--target-fps", p.target_fps, "prioritized: choose each frame's ray count to hold this frame rate")
       ->check(number_in(0, INFINITY, End::Open))->needs(path_flag);
   path_group->add_flag("--reference,--compare-full", p.compare_full,
                        "also render every frame fully (untimed) and report ssim_vs_full per frame")
