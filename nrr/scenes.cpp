@@ -160,12 +160,22 @@ SceneKind parse_scene_kind(const std::string& name) {
   throw InvalidInput("scene must be one of: blocks4, grass, urban; got '" + name + "'");
 }
 
+std::size_t default_triangles(SceneKind kind) {
+  switch (kind) {
+    case SceneKind::Blocks4: return 44;
+    case SceneKind::Grass: return 56000;
+    case SceneKind::Urban: return 50000;
+  }
+  return 0;
+}
+
 GeneratedScene make_scene(SceneKind kind, const SceneOptions& options) {
   if (kind == SceneKind::Blocks4) return make_blocks4();
   if (options.triangles != 0 && options.triangles < 100)
     throw InvalidInput("a grass or urban scene needs at least 100 triangles, got " + std::to_string(options.triangles));
-  if (kind == SceneKind::Grass) return make_grass(options.seed, options.triangles ? options.triangles : 56000);
-  return make_urban(options.seed, options.triangles ? options.triangles : 50000);
+  const std::size_t triangles = options.triangles ? options.triangles : default_triangles(kind);
+  if (kind == SceneKind::Grass) return make_grass(options.seed, triangles);
+  return make_urban(options.seed, triangles);
 }
 
 }  // namespace raysift::nrr

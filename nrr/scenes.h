@@ -18,9 +18,13 @@ SceneKind parse_scene_kind(const std::string& name);
 
 struct SceneOptions {
   std::uint64_t seed = 1;
-  /// Target triangle count; 0 = the default (grass 56000, urban 50000). Ignored by blocks4 (fixed).
+  /// Target triangle count; 0 = default_triangles(kind). Ignored by blocks4 (fixed).
   std::size_t triangles = 0;
 };
+
+/// The triangle count of a grass or urban scene when none is asked for (grass 56000, urban 50000; blocks4 44,
+/// fixed): one number for make_scene and the help texts.
+std::size_t default_triangles(SceneKind kind);
 
 struct GeneratedScene {
   TriMesh mesh;  ///< world units, y up

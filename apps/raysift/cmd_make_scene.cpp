@@ -37,7 +37,9 @@ RegisterCommand reg(
       sub.add_option("-o,--out", opt->out, "output mesh .ply/.obj/.off; the views go to <stem>.views.json")
           ->required()->check(has_extension({".ply", ".obj", ".off"}));
       sub.add_option("--triangles", opt->triangles,
-                     "target triangle count for grass/urban (0 = default: grass 56000, urban 50000)")
+                     "target triangle count for grass/urban (0 = default: grass " +
+                         std::to_string(nrr::default_triangles(nrr::SceneKind::Grass)) + ", urban " +
+                         std::to_string(nrr::default_triangles(nrr::SceneKind::Urban)) + ")")
           ->capture_default_str();
       return [opt, &common] {
         const nrr::SceneKind kind = nrr::parse_scene_kind(opt->kind);  // checked by CLI11
