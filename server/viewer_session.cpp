@@ -148,9 +148,13 @@ void ViewerSession::apply_camera(const Json& message) {
                        ", got " + std::to_string(spec.width) + "x" + std::to_string(spec.height));
   const Json seq = message.value("seq", Json());
   if (!seq.is_null() && !seq.is_number()) throw InvalidInput("camera message: seq must be a number, got " + seq.dump());
+  const Json client = message.value("client_ms", Json(0.0));
+  if (!client.is_number() || !(client.get<double>() >= 0 && client.get<double>() < 1e6))
+    throw InvalidInput("camera message: client_ms must be a number of ms >= 0, got " + client.dump());
   const std::lock_guard<std::mutex> lock(mutex_);
   view_.camera = spec;
   view_.camera_seq = seq;
+  view_.client_ms = client.get<double>();
   bump_version();
   cv_.notify_all();
 }
@@ -195,6 +199,10 @@ void ViewerSession::apply_settings(const Json& message) {
   cv_.notify_all();
 }
 
+double frame_budget_ms(double period_ms, double overhead_ms, double overrun_ms, double client_ms) {
+  return std::max(period_ms - overhead_ms - overrun_ms - std::min(client_ms, 0.25 * period_ms), 0.1 * period_ms);
+}
+
 void ViewerSession::bump_version() {
   ++view_.version;
   latest_version_.store(view_.version, std::memory_order_relaxed);
@@ -237,7 +245,7 @@ void ViewerSession::render_loop() {
       next_start = std::chrono::steady_clock::now() + std::chrono::microseconds(std::int64_t(period_ms * 1000));
     }
     rendered = view.version;
-    const double budget_ms = std::max(period_ms - overhead_ms - overrun_ms, 0.1 * period_ms);
+    const double budget_ms = frame_budget_ms(period_ms, overhead_ms, overrun_ms, view.client_ms);
     FrameRequest request;
     request.render = view.render.get();
     request.camera = view.camera;

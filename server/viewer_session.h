@@ -22,6 +22,11 @@
 
 namespace raysift::server {
 
+/// A budgeted frame's render budget: the period less the last frames' encode + send (`overhead_ms`), their overrun
+/// and the client's decode + display time (a camera message's latency pays all of them), the client's share capped
+/// at a quarter period (a slow client cannot take the render's time), and never below a tenth of the period.
+double frame_budget_ms(double period_ms, double overhead_ms, double overrun_ms, double client_ms);
+
 /// What every viewer shares, built once by `raysift serve`.
 struct ServeScene {
   std::shared_ptr<const app::RenderSession> base;  ///< volume, startup TF, bricks, feature cache
@@ -54,6 +59,7 @@ class ViewerSession : public ConnectionHandler {
   struct View {
     CameraSpec camera;
     Json camera_seq;  ///< the client's "seq" of the last camera message, null before one
+    double client_ms = 0;  ///< the client's decode + display time per frame ("client_ms"), kept out of the budget
     Settings settings;
     std::shared_ptr<const app::RenderSession> render;  ///< this viewer's TF
     std::shared_ptr<const sampling::FeatureGeometry> geometry;  ///< may still be an older TF's

@@ -116,7 +116,7 @@ function send_camera() {
   state.camera_sent_at = performance.now();
   const [w, h] = render_size();
   state.seq += 1;
-  state.last_camera = state.camera.message(w, h, state.seq);
+  state.last_camera = { ...state.camera.message(w, h, state.seq), client_ms: main_session.client_time_ms() };
   main_session.send(state.last_camera);
   state.sub?.send(state.last_camera);
 }

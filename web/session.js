@@ -4,7 +4,8 @@
 
 const RATE_WINDOW_MS = 1000;
 const LATENCY_KEEP = 500;
-const CAMERA_ANSWER_WAIT_MS = 1000;  // a camera message unanswered this long no longer holds the next one back
+const CAMERA_ANSWER_WAIT_MS = 1000;
+const CLIENT_MS_KEEP = 8;            // frames whose decode + display time the page reports  // a camera message unanswered this long no longer holds the next one back
 
 export function percentile(values, p) {
   if (values.length === 0) return null;
@@ -30,6 +31,8 @@ export class Session {
     this.draw_chain = Promise.resolve();
     this.sent_camera = new Map();    // seq -> performance.now() when sent, until a frame reflects it
     this.in_flight = null;           // {seq, sent} of the last camera message until a frame header reflects it
+    this.header_at = null;           // performance.now() when the pending frame's header arrived
+    this.client_ms = [];             // recent header -> drawn times (decode + display), newest last
     this.latencies_ms = [];          // camera message -> first pixels drawn that reflect it
     this.reflected_latencies_ms = []; // the same, only for the message each frame was rendered from
     this.draw_times = [];            // performance.now() of recent draws, for the achieved rate
@@ -43,6 +46,11 @@ export class Session {
   }
 
   is_open() { return this.ws.readyState === WebSocket.OPEN; }
+
+  /// The page's decode + display time per frame, sent with each camera message so that the server keeps it out of
+  /// the render budget (docs/serve.md): the largest of the last CLIENT_MS_KEEP frames, since a camera message's
+  /// latency pays it in full.
+  client_time_ms() { return this.client_ms.length ? Math.max(...this.client_ms) : 0; }
 
   send(message) {
     if (!this.is_open()) return;
@@ -71,6 +79,7 @@ export class Session {
       case "hello": return this.handlers.hello?.(msg);
       case "frame":
         this.pending_meta = msg;
+        this.header_at = performance.now();
         if (this.in_flight && typeof msg.camera_seq === "number" && msg.camera_seq >= this.in_flight.seq) {
           this.in_flight = null;
           this.handlers.camera_answered?.();
@@ -85,17 +94,18 @@ export class Session {
 
   receive_image(blob) {
     const meta = this.pending_meta;
+    const header_at = this.header_at;
     this.pending_meta = null;
     if (!meta) return this.handlers.error?.("image without a frame header");
     // PNG or JPEG: the decoder sniffs the bytes. Decoded in order; colorSpaceConversion "none" keeps the PNG's 8-bit values exactly (no gamma/profile
     // handling), so the canvas holds the bytes `raysift render -o x.png` writes.
     const decoded = createImageBitmap(blob, { colorSpaceConversion: "none", premultiplyAlpha: "none" });
     this.draw_chain = this.draw_chain.then(() => decoded).then(
-      (bitmap) => this.draw(bitmap, meta),
+      (bitmap) => this.draw(bitmap, meta, header_at),
       (err) => this.handlers.error?.(`could not decode a frame: ${err}`));
   }
 
-  draw(bitmap, meta) {
+  draw(bitmap, meta, header_at) {
     const c = this.canvas;
     if (c.width !== bitmap.width || c.height !== bitmap.height) {
       c.width = bitmap.width;
@@ -104,6 +114,10 @@ export class Session {
     c.getContext("2d").drawImage(bitmap, 0, 0);
     bitmap.close();
     const now = performance.now();
+    if (header_at !== null) {
+      this.client_ms.push(now - header_at);
+      if (this.client_ms.length > CLIENT_MS_KEEP) this.client_ms.shift();
+    }
     this.frames += 1;
     this.last = meta;
     this.record_latency(meta.camera_seq, now);

@@ -13,6 +13,7 @@
 #include "core/colour.h"
 #include "core/image.h"
 #include "server/embedded_files.h"
+#include "server/viewer_session.h"
 #include "tests/server/serve_client.h"
 #include "tests/support/test_support.h"
 #include "volume/histogram.h"
@@ -245,6 +246,28 @@ TEST(ServeProtocol, ATransparentTfImpliesNoIsoValueAndFramesGoWithoutFeatures) {
   EXPECT_EQ(test::png_size(f.image), std::make_pair(48, 36));
 }
 
+TEST(ServeBudget, TheClientsDisplayTimeIsKeptOutOfTheBudgetUpToAQuarterPeriod) {
+  EXPECT_DOUBLE_EQ(server::frame_budget_ms(100, 8, 5, 0), 87);
+  EXPECT_DOUBLE_EQ(server::frame_budget_ms(100, 8, 5, 20), 67);
+  EXPECT_DOUBLE_EQ(server::frame_budget_ms(100, 8, 5, 80), 62);  // capped at a quarter period
+  EXPECT_DOUBLE_EQ(server::frame_budget_ms(100, 60, 25, 25), 10);  // never below a tenth
+}
+
+TEST(ServeProtocol, ACameraMessagesClientTimeLowersTheFramesBudget) {
+  // --target-fps 10 (100 ms): the first frame of a view whose message says 80 ms of client time is budgeted at
+  // most 75 ms (the cap), while the messages without it keep the default view's budget.
+  const std::string dir = make_torus_dir("serve_client_ms");
+  ServeProcess server(dir, "torus.vdb --tf tf.json");
+  WsClient client(server.port());
+  Json camera = camera_message(client.hello(), 10);
+  camera["client_ms"] = 80;
+  client.send(camera);
+  ServeFrame f = client.read_frame();
+  while (f.header["camera_seq"] != 10) f = client.read_frame();
+  EXPECT_LE(f.header["budget_ms"].get<double>(), 75.0);
+  EXPECT_GE(f.header["budget_ms"].get<double>(), 10.0);
+}
+
 TEST(ServeProtocol, MalformedAndUnknownMessagesGetAnErrorAndTheConnectionStays) {
   const std::string dir = make_torus_dir("serve_errors");
   ServeProcess server(dir, "torus.vdb --tf tf.json");
@@ -252,7 +275,8 @@ TEST(ServeProtocol, MalformedAndUnknownMessagesGetAnErrorAndTheConnectionStays) 
   for (const char* bad : {"{bad", "[]", "42", R"({"kind":"camera"})", R"({"type":"zoom"})", R"({"type":7})",
                           R"({"type":"camera","eye":[0,0]})", R"({"type":"camera","width":-3})",
                           R"({"type":"camera","eye":"up"})", R"({"type":"camera","width":100000})",
-                          R"({"type":"camera","eye":[0,0,0],"target":[0,0,0]})",
+                          R"({"type":"camera","eye":[0,0,0],"target":[0,0,0]})", R"({"type":"camera","client_ms":-1})",
+                          R"({"type":"camera","client_ms":"slow"})",
                           R"({"type":"settings","mode":"fast"})", R"({"type":"settings","show":"depth"})",
                           R"({"type":"settings","target_fps":0})", R"({"type":"settings","features":["nope"]})",
                           R"({"type":"settings","format":"gif"})", R"({"type":"tf"})",
