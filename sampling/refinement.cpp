@@ -460,7 +460,6 @@ std::size_t round_size(const RefinementStop& stop, std::size_t done, double rays
     if (ms <= 0) return 0;
     // The estimate only sizes the round; trace_until stops at the deadline whatever it says.
     return std::max(kMinRound, std::size_t(ms * rays_per_ms) / 8);
-  } else {
   }
   if (done >= stop.rays) return 0;
   const std::size_t left = stop.rays - done;

@@ -135,6 +135,34 @@ TEST(Refinement, OneAndTwoThreadsTraceTheSamePixelsInLargeRounds) {
   EXPECT_EQ(one.pixels, two.pixels);
 }
 
+// The refiner keeps its per-pixel offers and percepts from frame to frame (a fresh buffer only when the size
+// changes, epochs in between): a frame must not see what an earlier frame of the same or another size offered.
+TEST(Refinement, AFrameIsTheSameAfterFramesOfOtherSizes) {
+  const ImageF small = disc();
+  constexpr int w = 200, h = 130;
+  ImageF large(w, h, -1.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      if (std::hypot(x - 90.0, y - 60.0) < 55) large(x, y) = 0.0f;
+  const TraceBatch bands = [](Span<const std::uint32_t> pixels, Span<Rgba> out) {
+    for (std::size_t i = 0; i < pixels.size(); ++i)
+      out[i] = (pixels[i] / 7) % 3 ? Rgba{0.8f, 0.6f, 0.1f, 1} : Rgba{0.2f, 0.1f, 0.4f, 1};
+  };
+  auto traced_mask = [&](const ImageF& imp, std::size_t rays) {
+    ImageRGBA image(imp.width, imp.height);
+    ImageMask traced(imp.width, imp.height, 0);
+    RefinementStop stop;
+    stop.rays = rays;
+    trace_refined(imp, make_fractal_pattern(imp.width, imp.height, 8), {}, stop, 3, bands, image, traced);
+    return traced.pixels;
+  };
+  const auto first = traced_mask(large, 2500);
+  const auto small_first = traced_mask(small, 700);
+  EXPECT_EQ(traced_mask(large, 2500), first);
+  EXPECT_EQ(traced_mask(large, 2500), first);  // same size again: the epoch, not a fresh buffer, separates them
+  EXPECT_EQ(traced_mask(small, 700), small_first);
+}
+
 TEST(Refinement, RefinedFrameOfAnAffineImageIsExact) {
   // The samples are affine, so refinement and either reconstruction must give the image back exactly.
   ImageF imp(kW, kH, 0.0f);
