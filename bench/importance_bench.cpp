@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "bench/bench_data.h"
+#include "core/heap_policy.h"
 #include "core/json_io.h"
 #include "core/timer.h"
 #include "features/importance.h"
@@ -142,6 +143,7 @@ void run_view(const SceneCase& c, const volume::Volume& vol, const volume::Trans
 }  // namespace
 
 int main(int argc, char** argv) {
+  raysift::keep_freed_buffers_for_reuse();  // as the raysift program (core/heap_policy.h)
   try {
     std::string feature_list = "contours,silhouettes";
     int rounds = 3, profile = 0;

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/heap_policy.h"
 #include "core/json_io.h"
 #include "core/scene.h"
 #include "core/timer.h"
@@ -114,6 +115,7 @@ Case bundled(const std::string& name, const std::string& stem) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  raysift::keep_freed_buffers_for_reuse();  // as the raysift program (core/heap_policy.h)
   const int runs = argc > 1 ? std::max(1, std::atoi(argv[1])) : 1;
   std::printf("isosurface_bench: %d run(s), median wall times; ratios < 1 mean raysift is faster\n", runs);
   std::vector<Case> cases = {bundled("engine CT", "engine_ct"), bundled("MRI head", "mri_head")};

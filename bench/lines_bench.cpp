@@ -24,6 +24,7 @@
 
 #include "bench/bench_data.h"
 #include "core/camera.h"
+#include "core/heap_policy.h"
 #include "core/json_io.h"
 #include "core/timer.h"
 #include "features/importance.h"
@@ -195,6 +196,7 @@ void engine_case() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  raysift::keep_freed_buffers_for_reuse();  // as the raysift program (core/heap_policy.h)
   try {
     engine_case();
     const std::string path =

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "bench/bench_data.h"
+#include "core/heap_policy.h"
 #include "core/timer.h"
 #include "volume/detail/vdb_grid.h"
 #include "volume/generate.h"
@@ -192,6 +193,7 @@ Case parse_case(const std::string& arg) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  raysift::keep_freed_buffers_for_reuse();  // as the raysift program (core/heap_policy.h)
   int runs = 7, threads = 2;
   bool ours_only = false;
   std::vector<Case> cases;

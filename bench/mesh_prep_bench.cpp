@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "bench/bench_data.h"
+#include "core/heap_policy.h"
 #include "core/timer.h"
 #include "mesh/decimation.h"
 #include "mesh/detail/openmesh_convert.h"
@@ -168,6 +169,7 @@ void throughput_note() {
 }
 
 int main(int argc, char** argv) {
+  raysift::keep_freed_buffers_for_reuse();  // as the raysift program (core/heap_policy.h)
   const int iterations = argc > 1 ? std::max(1, std::atoi(argv[1])) : 20;
   std::printf("threads: TBB default; load: see uptime\n");
   const volume::Volume engine = volume::load_vdb(raysift::bench::bundled_dataset("engine_ct.vdb"));

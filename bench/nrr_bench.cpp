@@ -27,6 +27,7 @@
 
 #include "bench/bench_data.h"
 #include "bench/heldout_scenes.h"
+#include "core/heap_policy.h"
 #include "core/timer.h"
 #include "nrr/metrics.h"
 #include "nrr/nrr_pipeline.h"
@@ -420,6 +421,7 @@ void metrics_tables(const std::vector<NamedScene>& scenes, const Args& a) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  raysift::keep_freed_buffers_for_reuse();  // as the raysift program (core/heap_policy.h)
   Args a;
   if (!parse_args(argc, argv, a)) {
     std::fprintf(stderr, "usage: nrr_bench [--res 1024] [--metrics-res 1024] [--frames 1000] [--vis-res 256] "

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "bench/heldout_scenes.h"
+#include "core/heap_policy.h"
 #include "core/timer.h"
 #include "nrr/metrics.h"
 #include "nrr/nrr_pipeline.h"
@@ -168,6 +169,7 @@ GapCheck check_gap(const std::string& name, const nrr::SampledScene& scene, cons
 }  // namespace
 
 int main(int argc, char** argv) {
+  raysift::keep_freed_buffers_for_reuse();  // as the raysift program (core/heap_policy.h)
   Args a;
   if (!parse_args(argc, argv, a)) {
     std::fprintf(stderr, "usage: nrr_fig7_bench [--frames 20] [--resolutions 256,512,...] [--csv FILE] "

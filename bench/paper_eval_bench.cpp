@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "bench/bench_data.h"
+#include "core/heap_policy.h"
 #include "core/json_io.h"
 #include "core/scene.h"
 #include "core/timer.h"
@@ -178,6 +179,7 @@ Scene3 bundled(const std::string& name, const std::string& stem, int w, int h) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  raysift::keep_freed_buffers_for_reuse();  // as the raysift program (core/heap_policy.h)
   const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
   const int w = quick ? 720 : 1440, h = quick ? 450 : 900;
   std::vector<Scene3> scenes = {bundled("engine CT", "engine_ct", w, h), bundled("MRI head", "mri_head", w, h)};

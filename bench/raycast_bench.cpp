@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "bench/bench_data.h"
+#include "core/heap_policy.h"
 #include "core/image.h"
 #include "core/json_io.h"
 #include "core/timer.h"
@@ -93,6 +94,7 @@ double parse_after(const std::string& text, const std::string& key) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  raysift::keep_freed_buffers_for_reuse();  // as the raysift program (core/heap_policy.h)
   BenchOptions o;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];

@@ -20,6 +20,7 @@
 
 #include "bench/bench_data.h"
 #include "core/camera.h"
+#include "core/heap_policy.h"
 #include "core/json_io.h"
 #include "core/timer.h"
 #include "features/saliency.h"
@@ -121,6 +122,7 @@ void run_orbit(const volume::Volume& vol, const volume::TransferFunction& tf, co
 }  // namespace
 
 int main(int argc, char** argv) {
+  raysift::keep_freed_buffers_for_reuse();  // as the raysift program (core/heap_policy.h)
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // progress shows up when redirected to a file
   int orbit_frames = 60;
   bool per_frame = false;

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "bench/bench_data.h"
+#include "core/heap_policy.h"
 #include "core/image.h"
 #include "core/timer.h"
 #include "core/tri_mesh.h"
@@ -270,6 +271,7 @@ void scaling_table(const Config& cfg) {
 void explain_table(const Config& cfg);  // below: item 4, peeling vs nrr on grass
 
 int main(int argc, char** argv) {
+  raysift::keep_freed_buffers_for_reuse();  // as the raysift program (core/heap_policy.h)
   Config cfg;
   for (int i = 1; i < argc; ++i) {
     const bool v = i + 1 < argc;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstring>
+#include <utility>
 
 #include "core/errors.h"
 #include "core/parallel.h"
@@ -434,7 +435,7 @@ sampling::SampledRender render_sampled_lockstep(const ImageF& importance, const 
   });
   out.samples = sum_on_root(tracer.samples);
   if (!is_root()) return out;
-  out.image = sampling::composite_frame(frame.image, background);
+  out.image = sampling::composite_frame(std::move(frame.image), background);
   sampling::record_frame(out, frame, importance_ms, total.elapsed_ms(), out.samples);
   return out;
 #else

@@ -3,6 +3,7 @@
 #include <mutex>
 
 #include "core/errors.h"
+#include "core/heap_policy.h"
 #include "python/py_bindings.h"
 #include "python/py_common.h"
 
@@ -114,6 +115,7 @@ void register_exceptions(pyb::module_& m) {
 PYBIND11_MODULE(_raysift, m) {
   m.doc() = "raysift: prioritized volume ray casting; NumPy arrays in and out, indexed [z, y, x] / [row, column]";
   m.attr("__version__") = RAYSIFT_VERSION;
+  raysift::keep_freed_buffers_for_reuse();  // as the raysift program: frame buffers reused across calls
   raysift::py::register_exceptions(m);
   raysift::py::bind_volumes(m);
   raysift::py::bind_render(m);

@@ -11,6 +11,7 @@
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <utility>
 
 #include "core/bilinear.h"
 #include "core/errors.h"
@@ -429,7 +430,7 @@ ImageRGBA sampled_frame(const volume::RayCaster& caster, const FeatureGeometry* 
     frame.alpha00 = so.mapping.alpha[0];
   }
   TraceCounts counts;
-  const SampledFrame s =
+  SampledFrame s =
       render_sampled(st.still_importance, cached_trace(caster, *st.cache, counts), so, clock.elapsed_ms());
   const std::size_t new_rays = counts.rays;
   st.cache->traced += new_rays;
@@ -438,7 +439,7 @@ ImageRGBA sampled_frame(const volume::RayCaster& caster, const FeatureGeometry* 
   frame.full_rays = s.full_rays;
   frame.trace_ms = s.trace_ms;
   st.last_timing = {0, s.trace_ms, new_rays};
-  return composite_frame(s.image, caster.options().background);
+  return composite_frame(std::move(s.image), caster.options().background);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include "core/errors.h"
 #include "core/parallel.h"
@@ -109,10 +110,9 @@ void composite_in_place(ImageRGBA& image, const Vec3f& background) {
 
 }  // namespace
 
-ImageRGBA composite_frame(const ImageRGBA& premultiplied, const Vec3f& background) {
-  ImageRGBA out = premultiplied;
-  composite_in_place(out, background);
-  return out;
+ImageRGBA composite_frame(ImageRGBA premultiplied, const Vec3f& background) {
+  composite_in_place(premultiplied, background);
+  return premultiplied;
 }
 
 VolumeFrame render_volume_frame(const volume::RayCaster& caster, const FeatureGeometry* geometry,
@@ -193,7 +193,7 @@ SampledRender render_sampled_volume(const volume::Volume& volume, const volume::
     out.progressive.push_back({frame.rays_traced, ms, frame.budget_too_small});
     record_frame(out, frame, k == 0 ? importance_ms : 0.0, ms, samples.load());
   }
-  out.image = composite_frame(frame.image, caster.options().background);
+  out.image = composite_frame(std::move(frame.image), caster.options().background);
   return out;
 }
 

@@ -95,8 +95,9 @@ struct VolumeFrame {
 VolumeFrame render_volume_frame(const volume::RayCaster& caster, const FeatureGeometry* geometry,
                                 const FeatureOptions& features, const SamplingOptions& sampling);
 
-/// Composites a premultiplied frame over `background` with the caster's shared rule.
-ImageRGBA composite_frame(const ImageRGBA& premultiplied, const Vec3f& background);
+/// Composites a premultiplied frame over `background` with the caster's shared rule. Taken by value: callers done
+/// with the premultiplied frame move it in and no frame-sized copy is made.
+ImageRGBA composite_frame(ImageRGBA premultiplied, const Vec3f& background);
 
 /// The feature geometry a render asks for: the prepared mesh `feature_mesh` when given (checked against the
 /// volume), else built with `options` (for `view` unless options.view is set), through `cache` when given.

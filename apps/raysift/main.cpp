@@ -11,6 +11,7 @@
 
 #include "apps/raysift/command.h"
 #include "core/errors.h"
+#include "core/heap_policy.h"
 #include "core/signals.h"
 #include "mpi/session.h"
 
@@ -75,6 +76,7 @@ std::string command_list(const CLI::App& cli) {
 int main(int argc, char** argv) {
   using namespace raysift;
   using namespace raysift::app;
+  keep_freed_buffers_for_reuse();  // frame-sized buffers reused, not faulted in again every frame
   const mpi::Session mpi_session(&argc, &argv);  // under mpirun: every rank runs the same command
   CLI::App cli{"raysift: prioritized volume ray casting and non-redundant scene discretization", "raysift"};
   cli.set_version_flag("--version", std::string("raysift ") + RAYSIFT_VERSION);
