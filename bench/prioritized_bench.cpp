@@ -1,5 +1,6 @@
 // The prioritized-rendering trade at EQUAL FRAME TIME (issue 13 item 3, docs/prioritized.md), in one run:
-//  * subsampling's time->error curve (fractions 0.03..0.7; frame = background test + trace + upscale);
+//  * subsampling's time->error curve (fractions 0.03..0.7; frame = background test + trace + upscale), measured in
+//    rounds interleaved with the budgeted frames below, so a drift of the machine's speed moves both alike;
 //  * prioritized (--budget-ms T, contours + silhouettes) and the control (no lines) at T = 10/20/40% of the
 //    full frame, each frame's measured time placed on subsampling's curve: ratios prioritized/subsample and
 //    control/subsample of FLIP_object, 1-SSIM_object on sRGB luma and on linear luminance (object = alpha > 0
@@ -13,7 +14,7 @@
 // Scenes: engine CT opaque and translucent (second view), MRI head opaque and translucent, and with --unseen
 // the smoke VDB from the shared datasets (bench/bench_data.h) with a TF written once (normalised to its value range) and never tuned.
 // Usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--linear] [--floor F] [--line-weight W]
-//                          [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N] [--budget-only]
+//                          [--alpha-weight W] [--uniform-share K] [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N] [--budget-only]
 //                          [--spacing S] [--max-budget-share K] [--orbit-only] [--orbit-frames N]
 #include <algorithm>
 #include <cmath>
@@ -23,9 +24,11 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bench/bench_data.h"
+#include "core/heap_policy.h"
 #include "core/json_io.h"
 #include "core/timer.h"
 #include "sampling/camera_path.h"
@@ -136,9 +139,9 @@ struct Scene {
 TimedError sampled_frame(const volume::RayCaster& caster, const ImageF& importance, double importance_ms,
                          sampling::SamplingOptions s, const ImageRGBA& full) {
   const Timer t;
-  const sampling::SampledFrame f = sampling::render_sampled(importance, sampling::caster_trace_batch(caster), s,
-                                                            importance_ms);
-  const ImageRGBA image = sampling::composite_frame(f.image, caster.options().background);
+  sampling::SampledFrame f = sampling::render_sampled(importance, sampling::caster_trace_batch(caster), s,
+                                                      importance_ms);
+  const ImageRGBA image = sampling::composite_frame(std::move(f.image), caster.options().background);
   return {importance_ms + t.elapsed_ms(), error_of(full, image), f.rays_traced, f.trace_ms, f.reconstruct_ms};
 }
 
@@ -236,56 +239,74 @@ struct SceneRun {
     }
   }
 
-  void subsample_curve() {
-    std::printf("subsample curve (min time of 3): fraction ms (x full) FLIP_obj 1-SSIM_obj 1-SSIMlin_obj\n");
-    for (double f : {0.03, 0.05, 0.075, 0.1, 0.15, 0.2, 0.3, 0.4, 0.55, 0.7}) {
-      sampling::SamplingOptions s = setup.sampling;
-      s.mode = sampling::SamplingMode::Subsample;
-      s.ray_fraction = f;
-      TimedError best{1e300, {}};
-      for (int r = 0; r < 3; ++r) {
+  static constexpr double kCurveFractions[] = {0.03, 0.05, 0.075, 0.1, 0.15, 0.2, 0.3, 0.4, 0.55, 0.7};
+  static constexpr double kBudgetShares[] = {0.1, 0.2, 0.4};
+  static constexpr int kRounds = 3;
+
+  // The budgeted frames of one share: with today's importance cost, with it charged at 5% of the full frame,
+  // and the control (no lines).
+  struct BudgetRows {
+    TimedError today, cheap, control;
+  };
+  std::vector<BudgetRows> budget_rows;  ///< per kBudgetShares entry
+
+  // The subsample curve and the budgeted frames, measured in kRounds interleaved rounds (one frame of each per
+  // round) so that a drift of the machine's speed during the run moves both alike. The curve keeps each
+  // fraction's fastest frame, a budgeted row the frame that traced the most rays (its counterpart for a fixed
+  // time).
+  void measure_equal_time() {
+    curve.assign(std::size(kCurveFractions), TimedError{1e300, {}});
+    budget_rows.assign(std::size(kBudgetShares), {});
+    auto keep_most_rays = [](TimedError& best, const TimedError& e, int round) {
+      if (round == 0 || e.rays > best.rays) best = e;
+    };
+    for (int round = 0; round < kRounds; ++round) {
+      for (std::size_t i = 0; i < std::size(kCurveFractions); ++i) {
+        sampling::SamplingOptions s = setup.sampling;
+        s.mode = sampling::SamplingMode::Subsample;
+        s.ray_fraction = kCurveFractions[i];
         const TimedError e = frame(background, bg_ms, s);
-        if (e.ms < best.ms) best = e;
+        if (e.ms < curve[i].ms) curve[i] = e;
       }
-      curve.push_back(best);
-      std::printf("  %.3f %7.0f (%4.2f) %.4f %.4f %.4f  [%zu rays, trace %.0f ms, reconstruct %.0f ms]\n", f,
-                  best.ms, best.ms / full_ms, best.error.flip, best.error.dssim, best.error.dssim_linear, best.rays,
-                  best.trace_ms, best.reconstruct_ms);
+      for (std::size_t i = 0; i < std::size(kBudgetShares); ++i) {
+        sampling::SamplingOptions s = setup.sampling;
+        s.budget_ms = kBudgetShares[i] * full_ms;
+        keep_most_rays(budget_rows[i].today, frame(lines, lines_ms, s), round);
+        keep_most_rays(budget_rows[i].cheap, frame(lines, 0.05 * full_ms, s), round);
+        keep_most_rays(budget_rows[i].control, frame(control, bg_ms, s), round);
+      }
     }
   }
 
-  // A budgeted frame's work depends on how much of the machine it got: of three frames keep the one that
-  // traced the most rays, the counterpart of the subsample curve's minimum time over repeats.
-  TimedError least_disturbed(const ImageF& importance, double importance_ms, const sampling::SamplingOptions& s) const {
-    TimedError best;
-    for (int r = 0; r < 3; ++r) {
-      const TimedError e = frame(importance, importance_ms, s);
-      if (r == 0 || e.rays > best.rays) best = e;
+  void print_subsample_curve() const {
+    std::printf("subsample curve (min time of %d, interleaved with the budgeted frames): fraction ms (x full) "
+                "FLIP_obj 1-SSIM_obj 1-SSIMlin_obj\n", kRounds);
+    for (std::size_t i = 0; i < curve.size(); ++i) {
+      const TimedError& best = curve[i];
+      std::printf("  %.3f %7.0f (%4.2f) %.4f %.4f %.4f  [%zu rays, trace %.0f ms, reconstruct %.0f ms]\n",
+                  kCurveFractions[i], best.ms, best.ms / full_ms, best.error.flip, best.error.dssim,
+                  best.error.dssim_linear, best.rays, best.trace_ms, best.reconstruct_ms);
     }
-    return best;
   }
 
-  void equal_time() const {
-    std::printf("equal time (best of 3 frames by rays traced): mode, budget (share of full), frame ms (x full), "
-                "ratio to subsample at that time: FLIP_obj  1-SSIM_obj  1-SSIMlin_obj\n");
-    for (double share : {0.1, 0.2, 0.4}) {
-      sampling::SamplingOptions s = setup.sampling;
-      s.budget_ms = share * full_ms;
-      const TimedError today = least_disturbed(lines, lines_ms, s);
-      const TimedError cheap = least_disturbed(lines, 0.05 * full_ms, s);
-      const TimedError ctrl = least_disturbed(control, bg_ms, s);
-      print_ratio_row("prioritized, today's imp.", share, today, error_at_time(curve, today.ms), full_ms);
-      print_ratio_row("prioritized, imp. at 5%", share, cheap, error_at_time(curve, cheap.ms), full_ms);
-      print_ratio_row("control (no lines)", share, ctrl, error_at_time(curve, ctrl.ms), full_ms);
+  void print_equal_time() const {
+    std::printf("equal time (best of %d frames by rays traced): mode, budget (share of full), frame ms (x full), "
+                "ratio to subsample at that time: FLIP_obj  1-SSIM_obj  1-SSIMlin_obj\n", kRounds);
+    for (std::size_t i = 0; i < std::size(kBudgetShares); ++i) {
+      const double share = kBudgetShares[i], budget_ms = share * full_ms;
+      const BudgetRows& r = budget_rows[i];
+      print_ratio_row("prioritized, today's imp.", share, r.today, error_at_time(curve, r.today.ms), full_ms);
+      print_ratio_row("prioritized, imp. at 5%", share, r.cheap, error_at_time(curve, r.cheap.ms), full_ms);
+      print_ratio_row("control (no lines)", share, r.control, error_at_time(curve, r.control.ms), full_ms);
       // The budget-aware rule (render_volume_frame): lines only if their cost fits the share of the budget.
       // It picks one of the two rows above; the lines' measured cost is what a caller with history predicts.
       const double lines_only_ms = std::max(0.0, lines_ms - bg_ms);
-      const bool with_lines = sampling::lines_fit_budget(lines_only_ms, s.budget_ms, setup.features.max_budget_share);
-      const TimedError& picked = with_lines ? today : ctrl;
+      const bool with_lines = sampling::lines_fit_budget(lines_only_ms, budget_ms, setup.features.max_budget_share);
+      const TimedError& picked = with_lines ? r.today : r.control;
       print_ratio_row(with_lines ? "budget-aware (lines)" : "budget-aware (no lines)", share, picked,
                       error_at_time(curve, picked.ms), full_ms);
       std::printf("    lines cost %.1f ms = %.1f%% of the budget (rule: <= %.0f%%; prior model predicts %.1f ms)\n",
-                  lines_only_ms, 100 * lines_only_ms / s.budget_ms, 100 * setup.features.max_budget_share,
+                  lines_only_ms, 100 * lines_only_ms / budget_ms, 100 * setup.features.max_budget_share,
                   setup.features.lines_cost.predict_ms(geometry.mesh.triangles.size(), full.size()));
     }
   }
@@ -380,8 +401,9 @@ void run_scene(const Scene& sc, const Setup& setup, int width, int height, bool 
     if (budget_table) run.budget_table();
     return;
   }
-  run.subsample_curve();
-  run.equal_time();
+  run.measure_equal_time();
+  run.print_subsample_curve();
+  run.print_equal_time();
   run.equal_rays();
   if (budget_table && setup.budget_frames > 0) run.budget_table();
   if (setup.orbit_frames > 0) run.orbit();
@@ -399,6 +421,7 @@ bool listed(const std::string& list, const std::string& name) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  raysift::keep_freed_buffers_for_reuse();  // as the raysift program (core/heap_policy.h)
   bool quick = false, unseen = false;
   std::string scenes;
   Setup setup;
@@ -410,6 +433,8 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--linear")) setup.sampling.interpolation = sampling::Interpolation::Linear;
     else if (!std::strcmp(argv[i], "--floor") && more) setup.sampling.refinement.floor = std::stof(argv[++i]);
     else if (!std::strcmp(argv[i], "--line-weight") && more) setup.sampling.refinement.line_weight = std::stof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--alpha-weight") && more) setup.sampling.refinement.alpha_weight = std::stof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--uniform-share") && more) setup.sampling.refinement.uniform_share = std::stof(argv[++i]);
     else if (!std::strcmp(argv[i], "--scenes") && more) scenes = argv[++i];
     else if (!std::strcmp(argv[i], "--alpha") && more) setup.sampling.mapping = sampling::parse_priority_mapping(argv[++i]);
     else if (!std::strcmp(argv[i], "--budget-frames") && more) setup.budget_frames = std::atoi(argv[++i]);
@@ -422,7 +447,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--orbit-csv") && more) setup.orbit_csv = argv[++i];
     else {
       std::fprintf(stderr, "usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--linear] [--floor F] "
-                           "[--line-weight W] [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N] [--budget-only] [--spacing S] [--max-budget-share K] [--orbit-only] [--orbit-frames N] [--orbit-csv FILE]\n");
+                           "[--line-weight W] [--alpha-weight W] [--uniform-share K] [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N] [--budget-only] [--spacing S] [--max-budget-share K] [--orbit-only] [--orbit-frames N] [--orbit-csv FILE]\n");
       return 2;
     }
   }
@@ -430,10 +455,12 @@ int main(int argc, char** argv) {
   const int width = quick ? 720 : 1440, height = quick ? 450 : 900;
   const auto& a = setup.sampling.mapping.alpha;
   std::printf("prioritized_bench: %dx%d, phong, features %s, %s reconstruction, refinement %s (floor %g, "
-              "line weight %g), alpha %g,%g,%g,%g,%g,%g, base spacing %d\n", width, height, sampling::kDefaultFeatures,
+              "line weight %g, alpha weight %g, uniform share %g), alpha %g,%g,%g,%g,%g,%g, base spacing %d\n", width, height,
+              sampling::kDefaultFeatures,
               setup.sampling.interpolation == sampling::Interpolation::Cubic ? "cubic" : "linear",
               setup.sampling.refinement.enabled ? "on" : "off",
-              setup.sampling.refinement.floor, setup.sampling.refinement.line_weight, a[0], a[1], a[2], a[3], a[4],
+              setup.sampling.refinement.floor, setup.sampling.refinement.line_weight,
+              setup.sampling.refinement.alpha_weight, setup.sampling.refinement.uniform_share, a[0], a[1], a[2], a[3], a[4],
               a[5], setup.sampling.base_spacing);
   const std::string dir = std::string(RAYSIFT_SOURCE_DIR) + "/datasets/";
   const std::vector<SceneCase> cases = {

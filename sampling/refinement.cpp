@@ -380,8 +380,8 @@ class Refiner {
       }
     }
     int spread = 0;
-    for (int k = 0; k < 4; ++k) spread = std::max(spread, hi[k] - lo[k]);
-    const float contrast = float(spread) * (1.0f / 255.0f);
+    for (int k = 0; k < 3; ++k) spread = std::max(spread, hi[k] - lo[k]);
+    const float contrast = std::max(float(spread), options_.alpha_weight * float(hi[3] - lo[3])) * (1.0f / 255.0f);
     const float priority =
         (contrast + options_.floor + options_.line_weight * imp_.pixels[r.pixel]) * level_share_[r.level];
     if (priority <= 1.05f * offered(offers_.pixels[r.pixel])) return;  // see push()
@@ -466,30 +466,104 @@ std::size_t round_size(const RefinementStop& stop, std::size_t done, double rays
   return std::min(left, std::max(kMinRound, left / 8));
 }
 
-}  // namespace
+// The object pixels of `level` >= 1, row-major. They lie on the lattice of its parent distance h (every h-th row
+// and column), so only that lattice is visited.
+std::vector<std::uint32_t> level_pixels(const ImageF& importance, const FractalPattern& pattern, int level) {
+  const int h = parent_offset(level, pattern.base_spacing);
+  std::vector<std::uint32_t> out;
+  for (int y = 0; y < importance.height; y += h)
+    for (int x = 0; x < importance.width; x += h)
+      if (fractal_level(x, y, pattern.base_spacing) == level && importance(x, y) >= 0)
+        out.push_back(std::uint32_t(y) * std::uint32_t(importance.width) + std::uint32_t(x));
+  return out;
+}
 
-RefinementResult trace_refined(const ImageF& importance, const FractalPattern& pattern,
-                               const RefinementOptions& options, const RefinementStop& stop, std::uint64_t seed,
-                               const TraceBatch& trace, ImageRGBA& image, ImageMask& traced, ImageMask* known) {
+// The uniform levels after level 0 (RefinementOptions::uniform_share): levels 1 .. k whole, at most down to the
+// 2-px lattice (level 4 for S = 8; finer levels would cost a pass over every pixel), k the largest whose rays with
+// level 0's fit the share of `expected_rays`. Uniform coverage is what makes a regular grid strong on shaded
+// texture, and a whole level is traced as one coherent batch without the refinement's per-ray bookkeeping.
+// `hashed`: ordered for a deadline, each square lattice (levels 1-2, then 3-4) in 64x64 tiles in a hashed order,
+// so that a cut leaves a prefix spread over the frame while a group of rays stays within a tile (in 16x16 tiles
+// a level-1 group spans 8 scattered tiles). Else in tile order.
+std::vector<std::uint32_t> uniform_levels(const ImageF& importance, const FractalPattern& pattern, double share,
+                                          std::size_t level0, double expected_rays, bool hashed, std::uint64_t seed) {
+  constexpr int kFinestUniformLevel = 4;
+  std::vector<std::uint32_t> out;
+  std::size_t count = level0;
+  for (int level = 1; level < std::min(pattern.num_levels, kFinestUniformLevel + 1) && share > 0; ++level) {
+    const std::vector<std::uint32_t> pixels = level_pixels(importance, pattern, level);
+    count += pixels.size();
+    if (double(count) > share * expected_rays) break;
+    out.insert(out.end(), pixels.begin(), pixels.end());
+  }
+  const int w = importance.width;
+  if (!hashed) {
+    in_tile_order(out, w);
+    return out;
+  }
+  const std::uint8_t* level = pattern.level.pixels.data();
+  sort_by_key(out.begin(), out.end(), [w, seed, level](std::uint32_t p) {
+    const std::uint32_t x = p % std::uint32_t(w), y = p / std::uint32_t(w);
+    const std::uint64_t lattice = std::uint64_t(level[p] - 1) / 2;
+    return lattice << 62 | std::uint64_t(pixel_hash((y / 64) * 4096u + x / 64, seed) & 0x3FFFFFFFu) << 32 | p;
+  });
+  return out;
+}
+
+// Traces level 0 and the uniform levels, what the refinement starts from, and returns them. With a ray count they
+// are one coherent batch. Under a deadline level 0 goes first (the frame's floor: `level0_overran` if it alone
+// overran), its rate `rays_per_ms` predicts the rays the time left holds, and the uniform levels that fit the
+// share of them are traced until the deadline.
+std::vector<std::uint32_t> trace_first(const ImageF& importance, const FractalPattern& pattern,
+                                       const RefinementOptions& options, const RefinementStop& stop,
+                                       std::uint64_t seed, const TraceBatch& trace, ImageRGBA& image,
+                                       RefinementResult& result, double& rays_per_ms) {
   const int w = importance.width, h = importance.height;
   std::vector<std::uint32_t> level0;
   for (int y = 0; y < h; y += pattern.base_spacing)
     for (int x = 0; x < w; x += pattern.base_spacing)
       if (importance(x, y) >= 0) level0.push_back(std::uint32_t(y) * std::uint32_t(w) + std::uint32_t(x));
+  result.level0 = level0.size();
+  if (!stop.now) {
+    const std::vector<std::uint32_t> uniform = uniform_levels(importance, pattern, options.uniform_share,
+                                                              level0.size(), double(stop.rays), false, seed);
+    level0.insert(level0.end(), uniform.begin(), uniform.end());
+    in_tile_order(level0, w);
+    trace_all(level0, trace, image);
+    result.rays = level0.size();
+    return level0;
+  }
   in_tile_order(level0, w);
-  // Budget rounds are sized from the rate measured on the stop's own clock (the deadline decides anyway).
-  const Timer wall;
-  const ElapsedMs clock = stop.now ? *stop.now : ElapsedMs([&wall] { return wall.elapsed_ms(); });
-  const double level0_start = clock();
+  const double level0_start = (*stop.now)();
   trace_all(level0, trace, image);
-  const double level0_ms = std::max(1e-3, clock() - level0_start);
+  const double now_ms = (*stop.now)();
+  rays_per_ms = double(level0.size()) / std::max(1e-3, now_ms - level0_start);
+  result.level0_overran = now_ms > stop.deadline_ms;
+  if (!result.level0_overran) {
+    const double expected_rays = double(level0.size()) + (stop.deadline_ms - now_ms) * rays_per_ms;
+    std::vector<std::uint32_t> uniform =
+        uniform_levels(importance, pattern, options.uniform_share, level0.size(), expected_rays, true, seed);
+    uniform.resize(trace_until(uniform, trace, image, *stop.now, stop.deadline_ms));
+    level0.insert(level0.end(), uniform.begin(), uniform.end());
+  }
+  result.rays = level0.size();
+  return level0;
+}
+
+}  // namespace
+
+RefinementResult trace_refined(const ImageF& importance, const FractalPattern& pattern,
+                               const RefinementOptions& options, const RefinementStop& stop, std::uint64_t seed,
+                               const TraceBatch& trace, ImageRGBA& image, ImageMask& traced, ImageMask* known) {
+  const int w = importance.width;
   RefinementResult result;
-  result.level0 = result.rays = level0.size();
-  result.level0_overran = stop.now && (*stop.now)() > stop.deadline_ms;
-  double rays_per_ms = double(level0.size()) / level0_ms;
+  // Budget rounds are sized from the rate measured on the stop's own clock (the deadline decides anyway).
+  double rays_per_ms = 0;
+  const std::vector<std::uint32_t> first =
+      trace_first(importance, pattern, options, stop, seed, trace, image, result, rays_per_ms);
 
   Refiner refiner(importance, pattern, options, seed, image, traced);
-  refiner.add_traced(level0);  // marks level 0 traced before the orphans are looked for
+  refiner.add_traced(first);  // marks level 0 and the uniform levels traced before the orphans are looked for
   refiner.offer_orphans();
   while (refiner.waiting() > 0) {
     // At most a quarter of the waiting candidates per round, so every round is a choice among them and an
@@ -503,9 +577,9 @@ RefinementResult trace_refined(const ImageF& importance, const FractalPattern& p
     bool last;
     if (stop.now) {
       in_hashed_tile_order(batch, w, seed);
-      const double start = clock();
+      const double start = (*stop.now)();
       batch.resize(trace_until(batch, trace, image, *stop.now, stop.deadline_ms));
-      rays_per_ms = std::max(rays_per_ms * 0.25, double(batch.size()) / std::max(1e-3, clock() - start));
+      rays_per_ms = std::max(rays_per_ms * 0.25, double(batch.size()) / std::max(1e-3, (*stop.now)() - start));
       last = batch.size() < popped || (*stop.now)() >= stop.deadline_ms;
     } else {
       in_tile_order(batch, w);

@@ -78,34 +78,68 @@ TEST(Refinement, TracedCellsHaveTracedCornersAndTheRequestedCount) {
   }
 }
 
+// The step edge image traced by the refinement, counting how often each pixel is traced. No background: the disc's
+// rim (alpha 1 against 0) would be an edge too.
+struct StepEdgeRun {
+  ImageF imp = ImageF(kW, kH, 0.0f);
+  FractalPattern p = make_fractal_pattern(kW, kH, 8);
+  std::vector<int> count = std::vector<int>(imp.size(), 0);
+  ImageRGBA image = ImageRGBA(kW, kH);
+  ImageMask traced = ImageMask(kW, kH, 0);
+
+  RefinementResult run(const RefinementOptions& options, std::size_t rays) {
+    RefinementStop stop;
+    stop.rays = rays;
+    tbb::task_arena serial(1);  // the counting tracer is not thread-safe
+    return serial.execute(
+        [&] { return trace_refined(imp, p, options, stop, 1, tracer(step_edge, &count), image, traced); });
+  }
+};
+
 TEST(Refinement, RaysGoToTheEdgeAndEveryPixelIsTracedOnceAtFractionOne) {
-  // No background here: the disc's rim (alpha 1 against 0) would be an edge too.
-  const ImageF imp(kW, kH, 0.0f);
-  const FractalPattern p = make_fractal_pattern(kW, kH, 8);
-  std::vector<int> count(imp.size(), 0);
-  ImageRGBA image(kW, kH);
-  ImageMask traced(kW, kH, 0);
-  RefinementStop stop;
-  stop.rays = 1000;  // 14% of the pixels
-  tbb::task_arena serial(1);  // the counting tracer is not thread-safe
-  serial.execute([&] { trace_refined(imp, p, {}, stop, 1, tracer(step_edge, &count), image, traced); });
+  StepEdgeRun edge;
+  RefinementOptions contrast_only;
+  contrast_only.uniform_share = 0;  // every ray after level 0 placed by the contrast (UniformLevels... below)
+  edge.run(contrast_only, 1000);    // 14% of the pixels
   // Object pixels within 3 px of the edge at x = 50 versus those farther than 10 px, per pixel.
   double near = 0, near_n = 0, far = 0, far_n = 0;
   for (int y = 0; y < kH; ++y)
     for (int x = 0; x < kW; ++x) {
-      if (imp(x, y) < 0) continue;
-      ASSERT_LE(count[std::size_t(y * kW + x)], 1);
-      if (std::abs(x - 50) <= 3) near += traced(x, y), ++near_n;
-      if (std::abs(x - 50) > 10) far += traced(x, y), ++far_n;
+      ASSERT_LE(edge.count[std::size_t(y * kW + x)], 1);
+      if (std::abs(x - 50) <= 3) near += edge.traced(x, y), ++near_n;
+      if (std::abs(x - 50) > 10) far += edge.traced(x, y), ++far_n;
     }
   EXPECT_GT(near / near_n, 3 * far / far_n) << "contrast must pull rays to the edge";
 
-  stop.rays = object_pixels(imp);
-  std::fill(count.begin(), count.end(), 0);
-  ImageRGBA all(kW, kH);
-  ImageMask all_traced(kW, kH, 0);
-  serial.execute([&] { trace_refined(imp, p, {}, stop, 1, tracer(step_edge, &count), all, all_traced); });
-  for (std::size_t i = 0; i < imp.size(); ++i) ASSERT_EQ(count[i], imp.pixels[i] >= 0 ? 1 : 0);
+  StepEdgeRun all;
+  all.run({}, object_pixels(all.imp));
+  for (std::size_t i = 0; i < all.imp.size(); ++i) ASSERT_EQ(all.count[i], 1);
+}
+
+// The default uniform share: at 10 % of the pixels, levels 1 and 2 (with level 0 the 4-px lattice, 6.25 % of the
+// pixels, within 90 % of the rays) are traced whole and once; level 3 would bring 12.5 %, more than 90 % of the
+// rays, so the rest is refined: part of level 3, most of it at the edge.
+TEST(Refinement, UniformLevelsAreTracedWholeAndTheRestGoesToTheEdge) {
+  StepEdgeRun edge;
+  EXPECT_EQ(edge.run({}, 700).rays, 700u);
+  double near = 0, near_n = 0, far = 0, far_n = 0;
+  std::size_t level3_traced = 0, level3 = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      const int traced = edge.count[std::size_t(y * kW + x)];
+      ASSERT_LE(traced, 1);
+      const int level = edge.p.level(x, y);
+      if (level <= 2) {
+        ASSERT_EQ(traced, 1) << "uniform level " << level << " pixel (" << x << "," << y << ") not traced";
+        continue;
+      }
+      if (level == 3) ++level3, level3_traced += std::size_t(traced);
+      if (std::abs(x - 50) <= 3) near += traced, ++near_n;
+      if (std::abs(x - 50) > 10) far += traced, ++far_n;
+    }
+  EXPECT_LT(level3_traced, level3) << "level 3 does not fit the rays: it is refined, not traced whole";
+  // Placement blind to the edge would give both bands the same density; 268 refined rays reach 2.9x near it.
+  EXPECT_GT(near / near_n, 2 * far / far_n) << "the rays beyond the uniform lattice must go to the edge";
 }
 
 // Rounds of several thousand rays span many of the parallel offer chunks (1024 sources each).
