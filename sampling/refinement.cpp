@@ -478,42 +478,59 @@ std::vector<std::uint32_t> level_pixels(const ImageF& importance, const FractalP
   return out;
 }
 
-// The uniform levels after level 0 (RefinementOptions::uniform_share): levels 1 .. k whole, at most down to the
-// 2-px lattice (level 4 for S = 8; finer levels would cost a pass over every pixel), k the largest whose rays with
-// level 0's fit the share of `expected_rays`. Uniform coverage is what makes a regular grid strong on shaded
+// Uniform levels (RefinementOptions::uniform_share) go down to the 2-px lattice at most (level 4 for S = 8): finer
+// levels would cost a pass over every pixel. Uniform coverage is what makes a regular grid strong on shaded
 // texture, and a whole level is traced as one coherent batch without the refinement's per-ray bookkeeping.
-// `hashed`: ordered for a deadline, each square lattice (levels 1-2, then 3-4) in 64x64 tiles in a hashed order,
-// so that a cut leaves a prefix spread over the frame while a group of rays stays within a tile (in 16x16 tiles
-// a level-1 group spans 8 scattered tiles). Else in tile order.
+constexpr int kFinestUniformLevel = 4;
+
+int last_uniform_level(const FractalPattern& pattern) { return std::min(pattern.num_levels - 1, kFinestUniformLevel); }
+
+// With a ray count: levels 1 .. k, k the largest whose rays with level 0's fit the share of the count.
 std::vector<std::uint32_t> uniform_levels(const ImageF& importance, const FractalPattern& pattern, double share,
-                                          std::size_t level0, double expected_rays, bool hashed, std::uint64_t seed) {
-  constexpr int kFinestUniformLevel = 4;
+                                          std::size_t level0, std::size_t rays) {
   std::vector<std::uint32_t> out;
   std::size_t count = level0;
-  for (int level = 1; level < std::min(pattern.num_levels, kFinestUniformLevel + 1) && share > 0; ++level) {
+  for (int level = 1; level <= last_uniform_level(pattern) && share > 0; ++level) {
     const std::vector<std::uint32_t> pixels = level_pixels(importance, pattern, level);
     count += pixels.size();
-    if (double(count) > share * expected_rays) break;
+    if (double(count) > share * double(rays)) break;
     out.insert(out.end(), pixels.begin(), pixels.end());
   }
+  return out;
+}
+
+// Under a deadline: level by level, each traced whole if, at the rate of the level traced last, its rays with
+// those traced so far fit the share of the rays the time left holds. Level 0's own rate is a poor guide (a
+// sparse lattice on cold caches): it decided the 4-px lattice either way from run to run on the same view. Each
+// level in 64x64 tiles in a hashed order, so that a cut leaves a prefix spread over the frame while a group of
+// rays stays within a tile (in 16x16 tiles a group of level-1 rays spans 8 scattered tiles). \return the rays
+// traced; `rays_per_ms` ends as the last level's rate.
+std::vector<std::uint32_t> trace_uniform_levels_until(const ImageF& importance, const FractalPattern& pattern,
+                                                      double share, const RefinementStop& stop, std::uint64_t seed,
+                                                      const TraceBatch& trace, ImageRGBA& image, std::size_t level0,
+                                                      double& rays_per_ms) {
+  std::vector<std::uint32_t> out;
   const int w = importance.width;
-  if (!hashed) {
-    in_tile_order(out, w);
-    return out;
+  for (int level = 1; level <= last_uniform_level(pattern) && share > 0; ++level) {
+    std::vector<std::uint32_t> pixels = level_pixels(importance, pattern, level);
+    const double start = (*stop.now)();
+    const double done = double(level0 + out.size());
+    if (done + double(pixels.size()) > share * (done + (stop.deadline_ms - start) * rays_per_ms)) break;
+    sort_by_key(pixels.begin(), pixels.end(), [w, seed](std::uint32_t p) {
+      const std::uint32_t x = p % std::uint32_t(w), y = p / std::uint32_t(w);
+      return std::uint64_t(pixel_hash((y / 64) * 4096u + x / 64, seed)) << 32 | p;
+    });
+    const std::size_t traced = trace_until(pixels, trace, image, *stop.now, stop.deadline_ms);
+    out.insert(out.end(), pixels.begin(), pixels.begin() + std::ptrdiff_t(traced));
+    if (traced < pixels.size()) break;
+    rays_per_ms = double(traced) / std::max(1e-3, (*stop.now)() - start);
   }
-  const std::uint8_t* level = pattern.level.pixels.data();
-  sort_by_key(out.begin(), out.end(), [w, seed, level](std::uint32_t p) {
-    const std::uint32_t x = p % std::uint32_t(w), y = p / std::uint32_t(w);
-    const std::uint64_t lattice = std::uint64_t(level[p] - 1) / 2;
-    return lattice << 62 | std::uint64_t(pixel_hash((y / 64) * 4096u + x / 64, seed) & 0x3FFFFFFFu) << 32 | p;
-  });
   return out;
 }
 
 // Traces level 0 and the uniform levels, what the refinement starts from, and returns them. With a ray count they
 // are one coherent batch. Under a deadline level 0 goes first (the frame's floor: `level0_overran` if it alone
-// overran), its rate `rays_per_ms` predicts the rays the time left holds, and the uniform levels that fit the
-// share of them are traced until the deadline.
+// overran), then the uniform levels level by level; `rays_per_ms` is the rate of the last of them.
 std::vector<std::uint32_t> trace_first(const ImageF& importance, const FractalPattern& pattern,
                                        const RefinementOptions& options, const RefinementStop& stop,
                                        std::uint64_t seed, const TraceBatch& trace, ImageRGBA& image,
@@ -525,8 +542,8 @@ std::vector<std::uint32_t> trace_first(const ImageF& importance, const FractalPa
       if (importance(x, y) >= 0) level0.push_back(std::uint32_t(y) * std::uint32_t(w) + std::uint32_t(x));
   result.level0 = level0.size();
   if (!stop.now) {
-    const std::vector<std::uint32_t> uniform = uniform_levels(importance, pattern, options.uniform_share,
-                                                              level0.size(), double(stop.rays), false, seed);
+    const std::vector<std::uint32_t> uniform =
+        uniform_levels(importance, pattern, options.uniform_share, level0.size(), stop.rays);
     level0.insert(level0.end(), uniform.begin(), uniform.end());
     in_tile_order(level0, w);
     trace_all(level0, trace, image);
@@ -540,10 +557,8 @@ std::vector<std::uint32_t> trace_first(const ImageF& importance, const FractalPa
   rays_per_ms = double(level0.size()) / std::max(1e-3, now_ms - level0_start);
   result.level0_overran = now_ms > stop.deadline_ms;
   if (!result.level0_overran) {
-    const double expected_rays = double(level0.size()) + (stop.deadline_ms - now_ms) * rays_per_ms;
-    std::vector<std::uint32_t> uniform =
-        uniform_levels(importance, pattern, options.uniform_share, level0.size(), expected_rays, true, seed);
-    uniform.resize(trace_until(uniform, trace, image, *stop.now, stop.deadline_ms));
+    const std::vector<std::uint32_t> uniform = trace_uniform_levels_until(
+        importance, pattern, options.uniform_share, stop, seed, trace, image, level0.size(), rays_per_ms);
     level0.insert(level0.end(), uniform.begin(), uniform.end());
   }
   result.rays = level0.size();
