@@ -127,9 +127,13 @@ VolumeFrame render_volume_frame(const volume::RayCaster& caster, const FeatureGe
                                                                     std::size_t(caster.width()) * std::size_t(caster.height())),
                                      budget, features.max_budget_share);
   const ImageF importance = frame_importance(caster, frame.lines_skipped ? nullptr : geometry, features);
-  frame.importance_ms = total.elapsed_ms();
+  // A caller's clock (SamplingOptions::clock_ms, ms since the frame began; tests use a virtual one) already counts
+  // the importance when render_sampled reads it. The wall clock restarts inside render_sampled, so there the
+  // importance's time is passed as spent. Mixing the two made a virtual-clock frame's deadline depend on wall time.
+  frame.importance_ms = sampling.clock_ms ? sampling.clock_ms() : total.elapsed_ms();
   std::atomic<std::uint64_t> samples{0};
-  frame.sampled = render_sampled(importance, caster_trace_batch(caster, &samples), sampling, frame.importance_ms);
+  frame.sampled = render_sampled(importance, caster_trace_batch(caster, &samples), sampling,
+                                 sampling.clock_ms ? 0.0 : frame.importance_ms);
   frame.samples = samples.load();
   frame.image = std::move(frame.sampled.image);
   frame.sampled.image = ImageRGBA();
