@@ -444,12 +444,12 @@ void in_tile_order(std::vector<std::uint32_t>& batch, int width) {
   });
 }
 
-// A budgeted round in 16x16 tiles (neighbouring rays share volume blocks), the tiles in a hashed order, so the
-// prefix the deadline leaves is spread over the frame rather than its top rows.
-void in_hashed_tile_order(std::vector<std::uint32_t>& batch, int width, std::uint64_t seed) {
-  sort_by_key(batch.begin(), batch.end(), [width, seed](std::uint32_t p) {
+// A budgeted batch in tiles of `tile` px (neighbouring rays share volume blocks), the tiles in a hashed order, so
+// the prefix the deadline leaves is spread over the frame rather than its top rows.
+void in_hashed_tile_order(std::vector<std::uint32_t>& batch, int width, std::uint64_t seed, std::uint32_t tile = 16) {
+  sort_by_key(batch.begin(), batch.end(), [width, seed, tile](std::uint32_t p) {
     const std::uint32_t x = p % std::uint32_t(width), y = p / std::uint32_t(width);
-    return std::uint64_t(pixel_hash((y / 16) * 4096u + x / 16, seed)) << 32 | p;
+    return std::uint64_t(pixel_hash((y / tile) * 4096u + x / tile, seed)) << 32 | p;
   });
 }
 
@@ -516,10 +516,7 @@ std::vector<std::uint32_t> trace_uniform_levels_until(const ImageF& importance, 
     const double start = (*stop.now)();
     const double done = double(level0 + out.size());
     if (done + double(pixels.size()) > share * (done + (stop.deadline_ms - start) * rays_per_ms)) break;
-    sort_by_key(pixels.begin(), pixels.end(), [w, seed](std::uint32_t p) {
-      const std::uint32_t x = p % std::uint32_t(w), y = p / std::uint32_t(w);
-      return std::uint64_t(pixel_hash((y / 64) * 4096u + x / 64, seed)) << 32 | p;
-    });
+    in_hashed_tile_order(pixels, w, seed, 64);
     const std::size_t traced = trace_until(pixels, trace, image, *stop.now, stop.deadline_ms);
     out.insert(out.end(), pixels.begin(), pixels.begin() + std::ptrdiff_t(traced));
     if (traced < pixels.size()) break;
