@@ -91,9 +91,9 @@ std::size_t ray_target(const SamplingOptions& options, std::size_t object, std::
 }
 
 
-double reconstruct_reserve(const SamplingOptions& options, int w, int h) {
+double reconstruct_reserve(const SamplingOptions& options, int w, int h, std::size_t object_pixels) {
   return options.reconstruct_reserve_ms >= 0 ? options.reconstruct_reserve_ms
-                                             : estimate_reconstruct_ms(w, h, options.base_spacing);
+                                             : estimate_reconstruct_ms(w, h, options.base_spacing, object_pixels);
 }
 
 // Budget mode with the a priori bucketed queue (RP paper section 5).
@@ -102,7 +102,7 @@ void trace_budgeted_queue(const ImageF& importance, const FractalPattern& patter
                           SampledFrame& frame, Timer& stage) {
   const RayQueue queue = make_bucketed_queue(importance, pattern, options.mapping, options.buckets, options.seed);
   frame.priorities_ms = stage.elapsed_ms();
-  const double reserve = reconstruct_reserve(options, importance.width, importance.height);
+  const double reserve = reconstruct_reserve(options, importance.width, importance.height, queue.object_pixels);
   stage.reset();
   const Span<const std::uint32_t> all(queue.pixels.data(), queue.pixels.size());
   trace_all(Span<const std::uint32_t>(all.data(), queue.level0_count), trace, frame.image);
@@ -125,7 +125,7 @@ void trace_refined_frame(const ImageF& importance, const FractalPattern& pattern
   stop.rays = target;
   if (options.budget_ms > 0) {
     stop.deadline_ms = options.budget_ms - elapsed_before_ms - reconstruct_reserve(options, importance.width,
-                                                                                  importance.height);
+                                                                                  importance.height, frame.full_rays);
     stop.now = &now;
   }
   frame.priorities_ms = stage.elapsed_ms();
@@ -175,23 +175,39 @@ ImageF control_importance(const ImageF& importance) {
   return out;
 }
 
-double estimate_reconstruct_ms(int width, int height, int base_spacing) {
-  // Measured once per (crop, spacing) and process: the estimate must not cost a reconstruction per frame.
+double estimate_reconstruct_ms(int width, int height, int base_spacing, std::size_t object_pixels) {
+  // Measured once per (crop, spacing) and process: the estimate must not cost a reconstruction per frame. Two
+  // per-pixel costs: an object pixel with only level 0 traced around it (the worst case), and a known pixel
+  // (background: only scanned). Each is the fastest of 3 runs: the first run pays for page faults on the fresh
+  // crop, which later frames do not (their buffers are reused), and a reserve sized by it wasted a third of a
+  // 15 ms budget.
+  struct PixelCosts {
+    double object_ms, known_ms;
+  };
   static std::mutex mutex;
-  static std::map<std::pair<int, int>, double> ms_per_pixel;  // key (crop side, spacing)
+  static std::map<std::pair<int, int>, PixelCosts> costs;  // key (crop side, spacing)
   const int side = std::min(256, std::max(16, std::min(width, height)));
   std::lock_guard<std::mutex> lock(mutex);
-  auto it = ms_per_pixel.find({side, base_spacing});
-  if (it == ms_per_pixel.end()) {
+  auto it = costs.find({side, base_spacing});
+  if (it == costs.end()) {
     const FractalPattern pattern = make_fractal_pattern(side, side, base_spacing);
-    ImageMask known(side, side, 0);
-    for (std::size_t i = 0; i < known.size(); ++i) known.pixels[i] = pattern.level.pixels[i] == 0 ? 1 : 0;
-    ImageRGBA image(side, side);
-    const Timer timer;
-    reconstruct_fractal(image, known, pattern);
-    it = ms_per_pixel.emplace(std::make_pair(side, base_spacing), timer.elapsed_ms() / double(side * side)).first;
+    auto ms_per_pixel = [&](const ImageMask& known) {
+      ImageRGBA image(side, side);
+      double best_ms = 1e300;
+      for (int run = 0; run < 3; ++run) {
+        const Timer timer;
+        reconstruct_fractal(image, known, pattern);
+        best_ms = std::min(best_ms, timer.elapsed_ms());
+      }
+      return best_ms / double(side * side);
+    };
+    ImageMask level0(side, side, 0);
+    for (std::size_t i = 0; i < level0.size(); ++i) level0.pixels[i] = pattern.level.pixels[i] == 0 ? 1 : 0;
+    const PixelCosts measured{ms_per_pixel(level0), ms_per_pixel(ImageMask(side, side, 1))};
+    it = costs.emplace(std::make_pair(side, base_spacing), measured).first;
   }
-  return it->second * double(width) * double(height);
+  const double pixels = double(width) * double(height), object = std::min(pixels, double(object_pixels));
+  return it->second.object_ms * object + it->second.known_ms * (pixels - object);
 }
 
 SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, const SamplingOptions& options,
@@ -294,7 +310,8 @@ SampledFrame ProgressiveSampler::next_frame(const TraceBatch& trace) {
     const double reserve = options_.reconstruct_reserve_ms >= 0 ? options_.reconstruct_reserve_ms
                            : last_reconstruct_ms_ >= 0
                                ? 1.25 * last_reconstruct_ms_
-                               : estimate_reconstruct_ms(samples_.width, samples_.height, options_.base_spacing);
+                               : estimate_reconstruct_ms(samples_.width, samples_.height, options_.base_spacing,
+                                                         queue_.object_pixels);
     const double deadline = options_.budget_ms - reserve;
     frame.budget_too_small = begin == 0 && now() > deadline;
     next_ += trace_until(Span<const std::uint32_t>(all.data() + next_, all.size() - next_), trace, samples_, now,

@@ -76,9 +76,11 @@ ImageF control_importance(const ImageF& importance);
 SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, const SamplingOptions& options,
                             double elapsed_before_ms = 0);
 
-/// \brief Wall time of one fractal reconstruction of a frame of this size with only level 0 traced
-/// (the worst case), measured once per process on a crop of at most 256x256 and scaled by area.
-double estimate_reconstruct_ms(int width, int height, int base_spacing);
+/// \brief Wall time of one fractal reconstruction of a frame of this size whose `object_pixels` have only level 0
+/// traced (the worst case) and the rest are background, from per-pixel costs measured once per process on a
+/// crop of at most 256x256 (warm: the fastest of 3 runs).
+double estimate_reconstruct_ms(int width, int height, int base_spacing,
+                               std::size_t object_pixels = std::numeric_limits<std::size_t>::max());
 
 /// \brief Budget mode over a sequence of frames: what to pass as SamplingOptions::reconstruct_reserve_ms.
 /// The reserve covers everything a frame does after its last ray (reconstruction, compositing, writing the
