@@ -112,6 +112,34 @@ std::array<std::array<int, 2>, 4> parent_offsets(int level, int spacing) {
 // they often share a cache line, which 16-byte records with the offers (as before) never did.
 using Percept = std::array<std::uint8_t, 4>;
 
+// A pixel's values as the contrast sees them: RGB through a square root (close to sRGB), alpha, quantised to
+// 1/255 (finer than any floor worth setting). A background pixel's image value is 0, so its percept is 0.
+Percept percept_of(const Rgba& c) {
+  auto code = [](float v) { return std::uint8_t(std::lround(255.0f * std::min(1.0f, std::max(0.0f, v)))); };
+  return {code(std::sqrt(std::max(0.0f, c.r))), code(std::sqrt(std::max(0.0f, c.g))), code(std::sqrt(std::max(0.0f, c.b))),
+          code(c.a)};
+}
+
+// The contrast of a cell's corners: the largest per-channel spread of their percepts, alpha weighted by
+// RefinementOptions::alpha_weight, in [0, 1]. Integer steps until the end; no corner leaves hi < lo, contrast 0.
+class CornerSpread {
+ public:
+  void add(const Percept& c) {
+    for (int k = 0; k < 4; ++k) {
+      lo_[k] = std::min(lo_[k], int(c[k]));
+      hi_[k] = std::max(hi_[k], int(c[k]));
+    }
+  }
+  float contrast(float alpha_weight) const {
+    int spread = 0;
+    for (int k = 0; k < 3; ++k) spread = std::max(spread, hi_[k] - lo_[k]);
+    return std::max(float(spread), alpha_weight * float(hi_[3] - lo_[3])) * (1.0f / 255.0f);
+  }
+
+ private:
+  std::array<int, 4> lo_{255, 255, 255, 255}, hi_{0, 0, 0, 0};
+};
+
 // What an offer reads and writes of the child. The offers outlive the frame (frame_buffer, next_epoch): `priority`
 // counts only when the epoch is the frame's, so a new frame bumps the epoch instead of clearing 10 MB.
 struct Offer {
@@ -279,14 +307,7 @@ class Refiner {
   }
 
  private:
-  // A traced pixel's values as the contrast sees them: RGB through a square root (close to sRGB), alpha,
-  // quantised to 1/255 (finer than any floor worth setting).
-  void record(std::uint32_t pixel) {
-    const Rgba& c = image_.pixels[pixel];
-    auto code = [](float v) { return std::uint8_t(std::lround(255.0f * std::min(1.0f, std::max(0.0f, v)))); };
-    percepts_.pixels[pixel] = {code(std::sqrt(std::max(0.0f, c.r))), code(std::sqrt(std::max(0.0f, c.g))),
-                               code(std::sqrt(std::max(0.0f, c.b))), code(c.a)};
-  }
+  void record(std::uint32_t pixel) { percepts_.pixels[pixel] = percept_of(image_.pixels[pixel]); }
 
   // open_(bx, by) = 1 where the S x S blocks around block (bx, by) hold background (`has`) or reach past the
   // image: the only places where a corner can be known without being traced.
@@ -368,20 +389,9 @@ class Refiner {
 
   // Appends `r` with its priority unless it would not be pushed.
   void evaluate(const Ready& r, std::vector<Candidate>& out) const {
-    // Per channel in integer 1/255 steps; no known parent leaves hi < lo, contrast 0.
-    std::array<int, 4> lo{255, 255, 255, 255}, hi{0, 0, 0, 0};
-    constexpr std::array<std::uint8_t, 4> kBackgroundPercept{};  // its image value (0) as record() codes it
-    for (int i = 0; i < r.known; ++i) {
-      const std::array<std::uint8_t, 4>& c =
-          (r.background >> i) & 1 ? kBackgroundPercept : percepts_.pixels[r.parents[i]];
-      for (int k = 0; k < 4; ++k) {
-        lo[k] = std::min(lo[k], int(c[k]));
-        hi[k] = std::max(hi[k], int(c[k]));
-      }
-    }
-    int spread = 0;
-    for (int k = 0; k < 3; ++k) spread = std::max(spread, hi[k] - lo[k]);
-    const float contrast = std::max(float(spread), options_.alpha_weight * float(hi[3] - lo[3])) * (1.0f / 255.0f);
+    CornerSpread spread;
+    for (int i = 0; i < r.known; ++i) spread.add((r.background >> i) & 1 ? Percept{} : percepts_.pixels[r.parents[i]]);
+    const float contrast = spread.contrast(options_.alpha_weight);
     const float priority =
         (contrast + options_.floor + options_.line_weight * imp_.pixels[r.pixel]) * level_share_[r.level];
     if (priority <= 1.05f * offered(offers_.pixels[r.pixel])) return;  // see push()
@@ -454,15 +464,8 @@ void in_hashed_tile_order(std::vector<std::uint32_t>& batch, int width, std::uin
 }
 
 // Rays to launch in the next round: an eighth of what is left, so late rounds see the early rounds' samples.
-std::size_t round_size(const RefinementStop& stop, std::size_t done, double rays_per_ms) {
-  if (stop.now) {
-    const double ms = stop.deadline_ms - (*stop.now)();
-    if (ms <= 0) return 0;
-    // The estimate only sizes the round; trace_until stops at the deadline whatever it says.
-    return std::max(kMinRound, std::size_t(ms * rays_per_ms) / 8);
-  }
-  if (done >= stop.rays) return 0;
-  const std::size_t left = stop.rays - done;
+std::size_t round_size(std::size_t rays, std::size_t done) {
+  const std::size_t left = rays - done;
   return std::min(left, std::max(kMinRound, left / 8));
 }
 
@@ -487,7 +490,7 @@ int last_uniform_level(const FractalPattern& pattern) { return std::min(pattern.
 
 // With a ray count: levels 1 .. k, k the largest whose rays with level 0's fit the share of the count.
 std::vector<std::uint32_t> uniform_levels(const ImageF& importance, const FractalPattern& pattern, double share,
-                                          std::size_t level0, std::size_t rays) {
+                                          std::size_t level0, std::size_t rays, int& whole) {
   std::vector<std::uint32_t> out;
   std::size_t count = level0;
   for (int level = 1; level <= last_uniform_level(pattern) && share > 0; ++level) {
@@ -495,6 +498,7 @@ std::vector<std::uint32_t> uniform_levels(const ImageF& importance, const Fracta
     count += pixels.size();
     if (double(count) > share * double(rays)) break;
     out.insert(out.end(), pixels.begin(), pixels.end());
+    whole = level;
   }
   return out;
 }
@@ -504,11 +508,11 @@ std::vector<std::uint32_t> uniform_levels(const ImageF& importance, const Fracta
 // sparse lattice on cold caches): it decided the 4-px lattice either way from run to run on the same view. Each
 // level in 64x64 tiles in a hashed order, so that a cut leaves a prefix spread over the frame while a group of
 // rays stays within a tile (in 16x16 tiles a group of level-1 rays spans 8 scattered tiles). \return the rays
-// traced; `rays_per_ms` ends as the last level's rate.
+// traced; `rays_per_ms` ends as the last level's rate, `whole` as the last level traced whole.
 std::vector<std::uint32_t> trace_uniform_levels_until(const ImageF& importance, const FractalPattern& pattern,
                                                       double share, const RefinementStop& stop, std::uint64_t seed,
                                                       const TraceBatch& trace, ImageRGBA& image, std::size_t level0,
-                                                      double& rays_per_ms) {
+                                                      double& rays_per_ms, int& whole) {
   std::vector<std::uint32_t> out;
   const int w = importance.width;
   for (int level = 1; level <= last_uniform_level(pattern) && share > 0; ++level) {
@@ -520,6 +524,7 @@ std::vector<std::uint32_t> trace_uniform_levels_until(const ImageF& importance, 
     const std::size_t traced = trace_until(pixels, trace, image, *stop.now, stop.deadline_ms);
     out.insert(out.end(), pixels.begin(), pixels.begin() + std::ptrdiff_t(traced));
     if (traced < pixels.size()) break;
+    whole = level;
     rays_per_ms = double(traced) / std::max(1e-3, (*stop.now)() - start);
   }
   return out;
@@ -531,7 +536,7 @@ std::vector<std::uint32_t> trace_uniform_levels_until(const ImageF& importance, 
 std::vector<std::uint32_t> trace_first(const ImageF& importance, const FractalPattern& pattern,
                                        const RefinementOptions& options, const RefinementStop& stop,
                                        std::uint64_t seed, const TraceBatch& trace, ImageRGBA& image,
-                                       RefinementResult& result, double& rays_per_ms) {
+                                       RefinementResult& result, double& rays_per_ms, int& whole) {
   const int w = importance.width, h = importance.height;
   std::vector<std::uint32_t> level0;
   for (int y = 0; y < h; y += pattern.base_spacing)
@@ -540,7 +545,7 @@ std::vector<std::uint32_t> trace_first(const ImageF& importance, const FractalPa
   result.level0 = level0.size();
   if (!stop.now) {
     const std::vector<std::uint32_t> uniform =
-        uniform_levels(importance, pattern, options.uniform_share, level0.size(), stop.rays);
+        uniform_levels(importance, pattern, options.uniform_share, level0.size(), stop.rays, whole);
     level0.insert(level0.end(), uniform.begin(), uniform.end());
     in_tile_order(level0, w);
     trace_all(level0, trace, image);
@@ -555,11 +560,57 @@ std::vector<std::uint32_t> trace_first(const ImageF& importance, const FractalPa
   result.level0_overran = now_ms > stop.deadline_ms;
   if (!result.level0_overran) {
     const std::vector<std::uint32_t> uniform = trace_uniform_levels_until(
-        importance, pattern, options.uniform_share, stop, seed, trace, image, level0.size(), rays_per_ms);
+        importance, pattern, options.uniform_share, stop, seed, trace, image, level0.size(), rays_per_ms, whole);
     level0.insert(level0.end(), uniform.begin(), uniform.end());
   }
   result.rays = level0.size();
   return level0;
+}
+
+
+// Under a deadline, after the uniform levels: `pixels`, the object pixels of `level`, all of whose parents are
+// traced (the levels before it were traced whole) or background, ranked once by the contrast of those parents plus
+// the line importance (the refiner's priority, whose floor and level share are the same for all of them), and
+// traced in that order in slices of a quarter of what the time left holds, each in hashed tile order, until the
+// deadline. No rounds and no offers: every priority is known before the first ray (docs/prioritized.md, "Budget
+// mode without rounds"). \return the pixels traced; `rays_per_ms` ends as the rate of the last slice.
+std::vector<std::uint32_t> trace_ranked_until(const std::vector<std::uint32_t>& pixels, int level,
+                                              const ImageF& importance, const FractalPattern& pattern,
+                                              const RefinementOptions& options, const RefinementStop& stop,
+                                              std::uint64_t seed, const TraceBatch& trace, ImageRGBA& image,
+                                              double& rays_per_ms) {
+  const int w = importance.width, h = importance.height;
+  const auto offsets = parent_offsets(level, pattern.base_spacing);
+  // Key: the priority quantised to 2^-18 (descending), a hashed tie-break, the pixel.
+  std::vector<std::uint64_t> keys(pixels.size());
+  parallel_for_each(pixels.size(), [&](std::size_t i) {
+    const std::uint32_t p = pixels[i];
+    const int x = int(p % std::uint32_t(w)), y = int(p / std::uint32_t(w));
+    CornerSpread spread;  // a background parent's image value, and percept, is 0
+    for (const auto& o : offsets)
+      if (x + o[0] >= 0 && y + o[1] >= 0 && x + o[0] < w && y + o[1] < h) spread.add(percept_of(image(x + o[0], y + o[1])));
+    const float priority =
+        std::min(3.9f, spread.contrast(options.alpha_weight) + options.line_weight * importance.pixels[p]);
+    const auto rank = std::uint32_t(0xFFFFFu - std::uint32_t(priority * float(1 << 18)));
+    keys[i] = std::uint64_t(rank << 12 | (pixel_hash(p, seed) & 0xFFFu)) << 32 | p;
+  }, true, std::size_t(4096));
+  sort_keys(keys);
+  std::vector<std::uint32_t> traced;
+  for (std::size_t done = 0; done < keys.size();) {
+    const double ms = stop.deadline_ms - (*stop.now)();
+    if (ms <= 0) break;
+    const std::size_t slice = std::min(keys.size() - done, std::max(kMinRound, std::size_t(ms * rays_per_ms) / 4));
+    std::vector<std::uint32_t> batch;
+    for (std::size_t k = done; k < done + slice; ++k) batch.push_back(std::uint32_t(keys[k] & 0xFFFFFFFFu));
+    in_hashed_tile_order(batch, w, seed);
+    const double start = (*stop.now)();
+    const std::size_t n = trace_until(batch, trace, image, *stop.now, stop.deadline_ms);
+    traced.insert(traced.end(), batch.begin(), batch.begin() + std::ptrdiff_t(n));
+    done += slice;
+    if (n < slice) break;
+    rays_per_ms = double(n) / std::max(1e-3, (*stop.now)() - start);
+  }
+  return traced;
 }
 
 }  // namespace
@@ -569,38 +620,44 @@ RefinementResult trace_refined(const ImageF& importance, const FractalPattern& p
                                const TraceBatch& trace, ImageRGBA& image, ImageMask& traced, ImageMask* known) {
   const int w = importance.width;
   RefinementResult result;
-  // Budget rounds are sized from the rate measured on the stop's own clock (the deadline decides anyway).
-  double rays_per_ms = 0;
+  double rays_per_ms = 0;  // under a deadline: the rate of the level traced last, on the stop's own clock
+  int whole = 0;
   const std::vector<std::uint32_t> first =
-      trace_first(importance, pattern, options, stop, seed, trace, image, result, rays_per_ms);
+      trace_first(importance, pattern, options, stop, seed, trace, image, result, rays_per_ms, whole);
+  if (stop.now) {
+    for (std::uint32_t p : first) traced.pixels[p] = 1;
+    // Level by level while the time lasts: a level traced whole makes the next one's parents known.
+    for (int level = whole + 1; level < pattern.num_levels && !result.level0_overran; ++level) {
+      const std::vector<std::uint32_t> pixels = level_pixels(importance, pattern, level);
+      const std::vector<std::uint32_t> more =
+          trace_ranked_until(pixels, level, importance, pattern, options, stop, seed, trace, image, rays_per_ms);
+      for (std::uint32_t p : more) traced.pixels[p] = 1;
+      result.rays += more.size();
+      if (more.size() < pixels.size()) break;
+    }
+    if (known) {
+      *known = ImageMask(w, importance.height, 0);
+      parallel_for_each(known->size(), [&](std::size_t i) {
+        known->pixels[i] = importance.pixels[i] < 0 || traced.pixels[i] ? 1 : 0;
+      }, true, std::size_t(1) << 14);
+    }
+    return result;
+  }
 
   Refiner refiner(importance, pattern, options, seed, image, traced);
   refiner.add_traced(first);  // marks level 0 and the uniform levels traced before the orphans are looked for
   refiner.offer_orphans();
-  while (refiner.waiting() > 0) {
+  while (refiner.waiting() > 0 && result.rays < stop.rays) {
     // At most a quarter of the waiting candidates per round, so every round is a choice among them and an
-    // edge can be followed down several levels (one per round) before the budget is spent on breadth.
-    const std::size_t want = std::min(round_size(stop, result.rays, rays_per_ms),
-                                      std::max<std::size_t>(1, refiner.waiting() / 4));
-    if (want == 0) break;
-    std::vector<std::uint32_t> batch = refiner.pop(want);
-    const std::size_t popped = batch.size();
-    if (popped == 0) break;  // only stale entries were left
-    bool last;
-    if (stop.now) {
-      in_hashed_tile_order(batch, w, seed);
-      const double start = (*stop.now)();
-      batch.resize(trace_until(batch, trace, image, *stop.now, stop.deadline_ms));
-      rays_per_ms = std::max(rays_per_ms * 0.25, double(batch.size()) / std::max(1e-3, (*stop.now)() - start));
-      last = batch.size() < popped || (*stop.now)() >= stop.deadline_ms;
-    } else {
-      in_tile_order(batch, w);
-      trace_all(batch, trace, image);
-      last = result.rays + batch.size() >= stop.rays;
-    }
+    // edge can be followed down several levels (one per round) before the rays are spent on breadth.
+    std::vector<std::uint32_t> batch =
+        refiner.pop(std::min(round_size(stop.rays, result.rays), std::max<std::size_t>(1, refiner.waiting() / 4)));
+    if (batch.empty()) break;  // only stale entries were left
+    in_tile_order(batch, w);
+    trace_all(batch, trace, image);
+    const bool last = result.rays + batch.size() >= stop.rays;
     refiner.add_traced(batch, !last);
     result.rays += batch.size();
-    if (last) break;
   }
   if (known) refiner.known_mask(*known);
   return result;

@@ -5,9 +5,12 @@
 /// removes, (contrast of its parents + floor + line_weight * p_imp) * 2^-l: the contrast is the largest
 /// per-channel spread of the parents (RGB through a square root, close to the sRGB the metrics see), 2^-l the
 /// share of the frame one ray of that level covers. The floor keeps coverage even where the samples agree
-/// (subsampling's strength on shaded texture). Candidates are traced in rounds of the highest priorities;
-/// each round's samples raise or lower their children's priorities. Every traced cell's corners are
-/// traced, so the hierarchical reconstruction (reconstruction.h) builds on them.
+/// (subsampling's strength on shaded texture). With a ray count, candidates are traced in rounds of the highest
+/// priorities; each round's samples raise or lower their children's priorities. Under a deadline there are no
+/// rounds: after the uniform levels, the next level's pixels are ranked once by the same contrast and traced in
+/// that order until the deadline (the rounds' offers cost more of a frame's time than their better placement
+/// gained, docs/prioritized.md "Budget mode without rounds"). Every traced cell's corners are traced, so the
+/// hierarchical reconstruction (reconstruction.h) builds on them.
 #include <cstdint>
 
 #include "core/image.h"
@@ -49,7 +52,8 @@ struct RefinementResult {
   bool level0_overran = false;  ///< the deadline had passed after level 0 alone
 };
 
-/// \brief Traces level 0 and then refines until the stop (or every object pixel is traced).
+/// \brief Traces level 0 and the uniform levels, then refines until the stop (or every object pixel is traced):
+/// with a ray count in rounds, under a deadline through the next level in contrast order.
 /// \param importance < 0 = background (never traced), else p_imp
 /// \param image receives the traced values; \param traced is set to 1 on traced pixels
 /// With a ray-count stop the result is the same for any thread count (rounds and ties are fixed by the

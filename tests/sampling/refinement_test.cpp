@@ -143,6 +143,46 @@ TEST(Refinement, UniformLevelsAreTracedWholeAndTheRestGoesToTheEdge) {
 }
 
 // Rounds of several thousand rays span many of the parallel offer chunks (1024 sources each).
+// Under a deadline the level after the uniform ones is ranked once by its parents' contrast: 12 virtual ms at 10 us
+// a ray hold levels 0-3 (864 rays) and part of level 4 (864 pixels), and every level-4 pixel whose parents straddle
+// the edge comes before any whose parents agree.
+TEST(Refinement, UnderADeadlineTheNextLevelIsTracedInContrastOrder) {
+  StepEdgeRun edge;
+  std::atomic<std::int64_t> clock_us{0};
+  const ElapsedMs now = [&clock_us] { return double(clock_us.load()) / 1000.0; };
+  RefinementStop stop;
+  stop.deadline_ms = 12;
+  stop.now = &now;
+  tbb::task_arena serial(1);  // the counting tracer is not thread-safe
+  serial.execute([&] {
+    trace_refined(edge.imp, edge.p, {}, stop, 1, tracer(step_edge, &edge.count, &clock_us), edge.image, edge.traced);
+  });
+  std::size_t level4 = 0, level4_traced = 0, straddling = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      const int traced = edge.count[std::size_t(y * kW + x)], level = edge.p.level(x, y);
+      ASSERT_LE(traced, 1);
+      ASSERT_EQ(traced, edge.traced(x, y));
+      if (level <= 3) {
+        ASSERT_EQ(traced, 1) << "uniform level " << level << " pixel (" << x << "," << y << ")";
+      } else if (level >= 5) {
+        ASSERT_EQ(traced, 0) << "level " << level << " before level 4 is whole";
+      }
+      if (level != 4) continue;
+      ++level4, level4_traced += std::size_t(traced);
+      bool dark = false, bright = false;
+      for (int dx : {-2, 2}) (x + dx < 50 ? dark : bright) = true;  // level-4 parents: (x +- 2, y), (x, y +- 2)
+      (x < 50 ? dark : bright) = true;
+      if (dark && bright) {
+        ++straddling;
+        EXPECT_EQ(traced, 1) << "edge pixel (" << x << "," << y << ") left for one with flat parents";
+      }
+    }
+  EXPECT_GT(straddling, 0u);
+  EXPECT_GT(level4_traced, straddling) << "the deadline leaves time beyond the edge";
+  EXPECT_LT(level4_traced, level4) << "the deadline must cut level 4";
+}
+
 TEST(Refinement, OneAndTwoThreadsTraceTheSamePixelsInLargeRounds) {
   constexpr int w = 320, h = 240;
   ImageF imp(w, h, -1.0f);
@@ -239,15 +279,15 @@ TEST(Refinement, BudgetStopsLaunchingAtTheDeadlineOnAVirtualClock) {
   EXPECT_EQ(tiny.rays_traced, tiny.level0_rays);
 }
 
-TEST(Refinement, KnownMaskIsBackgroundOrTracedAlsoWhenADeadlineCutsARound) {
-  // The reconstruction keeps exactly these pixels; a round cut by the deadline leaves popped pixels untraced.
+TEST(Refinement, KnownMaskIsBackgroundOrTracedAlsoWhenADeadlineCutsASlice) {
+  // The reconstruction keeps exactly these pixels; a slice cut by the deadline leaves ranked pixels untraced.
   const ImageF imp = disc();
   const FractalPattern p = make_fractal_pattern(kW, kH, 8);
   std::atomic<std::int64_t> clock_us{0};
   const ElapsedMs now = [&clock_us] { return double(clock_us.load()) / 1000.0; };
   RefinementStop by_count, by_clock;
   by_count.rays = 700;
-  by_clock.deadline_ms = 5.05;  // inside a round: level 0 is ~0.4 ms, the first round alone ~2.5 ms
+  by_clock.deadline_ms = 5.05;  // inside a slice of the level traced in contrast order
   by_clock.now = &now;
   for (const RefinementStop& stop : {by_count, by_clock}) {
     ImageRGBA image(kW, kH);
