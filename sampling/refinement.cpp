@@ -115,7 +115,13 @@ using Percept = std::array<std::uint8_t, 4>;
 // A pixel's values as the contrast sees them: RGB through a square root (close to sRGB), alpha, quantised to
 // 1/255 (finer than any floor worth setting). A background pixel's image value is 0, so its percept is 0.
 Percept percept_of(const Rgba& c) {
-  auto code = [](float v) { return std::uint8_t(std::lround(255.0f * std::min(1.0f, std::max(0.0f, v)))); };
+  // std::lround of x in [0, 255] without the libm call (a third of a ranked level's set-up): the fraction x - floor(x)
+  // is exact in float, so comparing it with 0.5 rounds half away from zero exactly as lround does.
+  auto code = [](float v) {
+    const float x = 255.0f * std::min(1.0f, std::max(0.0f, v));
+    const int whole = int(x);
+    return std::uint8_t(whole + (x - float(whole) >= 0.5f ? 1 : 0));
+  };
   return {code(std::sqrt(std::max(0.0f, c.r))), code(std::sqrt(std::max(0.0f, c.g))), code(std::sqrt(std::max(0.0f, c.b))),
           code(c.a)};
 }
@@ -469,15 +475,20 @@ std::size_t round_size(std::size_t rays, std::size_t done) {
   return std::min(left, std::max(kMinRound, left / 8));
 }
 
-// The object pixels of `level` >= 1, row-major. They lie on the lattice of its parent distance h (every h-th row
-// and column), so only that lattice is visited.
+// The object pixels of `level` >= 1, row-major. With h its parent distance they are, in units of h, the points
+// with both coordinates odd (odd levels: square centres) or exactly one odd (even levels: diamond centres), so
+// only those are visited (the finest levels have h = 1).
 std::vector<std::uint32_t> level_pixels(const ImageF& importance, const FractalPattern& pattern, int level) {
   const int h = parent_offset(level, pattern.base_spacing);
   std::vector<std::uint32_t> out;
-  for (int y = 0; y < importance.height; y += h)
-    for (int x = 0; x < importance.width; x += h)
-      if (fractal_level(x, y, pattern.base_spacing) == level && importance(x, y) >= 0)
-        out.push_back(std::uint32_t(y) * std::uint32_t(importance.width) + std::uint32_t(x));
+  for (int row = 0; row * h < importance.height; ++row) {
+    const int y = row * h;
+    // Odd levels: odd rows, odd columns. Even levels: odd rows, even columns; even rows, odd columns.
+    if (level % 2 == 1 && row % 2 == 0) continue;
+    const int first = level % 2 == 1 || row % 2 == 0 ? h : 0;
+    for (int x = first; x < importance.width; x += 2 * h)
+      if (importance(x, y) >= 0) out.push_back(std::uint32_t(y) * std::uint32_t(importance.width) + std::uint32_t(x));
+  }
   return out;
 }
 
