@@ -380,13 +380,22 @@ ImageRGBA full_frame(const volume::RayCaster& caster, PathState& st, PathFrame& 
 
 /// A prioritized frame's selection: the controller's ray count (the highest-priority rays, without refinement:
 /// the count is the time budget), or, for a still camera, a superset of the frame before (a threshold frame
-/// raises α00, a fraction frame adds another fraction; a larger top count contains the smaller one).
+/// raises α00, a fraction frame adds another fraction; a larger top count contains the smaller one). The path's
+/// first kBudgetedFrames frames are traced against the target as a deadline (budget mode measures its own rate),
+/// and the controller starts from the last of them: the first frame of a process pays one-time costs (page faults
+/// on new buffers: 147 ms against a 55 ms target on the unseen smoke), and seeded with them the controller gave
+/// level 0 only to the first 4 frames of a 30-frame orbit (SSIM 0.52 each) while its estimate decayed.
+constexpr std::size_t kBudgetedFrames = 2;
+
 SamplingOptions prioritized_options(PathState& st, const PathFrame& frame) {
   SamplingOptions so = st.options.sampling;
+  if (st.controller && st.frames.size() < kBudgetedFrames) {
+    so.budget_ms = st.controller->target_ms();
+    return so;
+  }
   if (st.controller) {
     const ObjectCounts counts = count_object_pixels(st.still_importance, *st.pattern);
-    std::size_t rays = st.frames.empty() ? counts.level0  // no cost known yet
-                                         : st.controller->update(st.last_timing, counts, frame.refined ? st.cache->traced : 0);
+    std::size_t rays = st.controller->update(st.last_timing, counts, frame.refined ? st.cache->traced : 0);
     if (frame.refined) rays = std::max(rays, st.rays);
     st.rays = rays;
     so.threshold = std::numeric_limits<float>::quiet_NaN();

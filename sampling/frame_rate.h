@@ -32,8 +32,9 @@ struct FrameTiming {
   std::size_t rays_traced = 0;
 };
 
-/// \brief The feedback loop: the first frame of a path traces level 0 only (no cost is known yet); after each
-/// frame, update() with its timing and the object counts of the frame that follows gives that frame's ray count.
+/// \brief The feedback loop: after each frame, update() with its timing and the object counts of the frame that
+/// follows gives that frame's ray count. Before its first update no cost is known: render_camera_path traces the
+/// first frames against the target as a deadline and starts the controller from the last of them.
 /// @warning Holds the running estimates of one camera path; not thread-safe.
 class FrameRateController {
  public:

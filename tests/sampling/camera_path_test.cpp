@@ -260,6 +260,28 @@ TEST(RenderCameraPath, FullModeOnAnOrbitMatchesSingleRenders) {
   EXPECT_EQ(summary.target_ms, 0.0);
 }
 
+// With a target frame rate the first two frames are traced against the target as a deadline (no cost per ray is
+// known yet); a target of one frame per 1000 s leaves time for every ray, so both equal the full render, while the
+// controller sizes the third frame by ray count (level 0 at least, whatever it learned).
+TEST(RenderCameraPath, FirstFramesOfATargetRateAreTracedAgainstTheTarget) {
+  const PathScene scene;
+  const std::vector<CameraSpec> cams{scene.camera(0), scene.camera(30), scene.camera(60)};
+  PathRenderOptions opt;
+  opt.sampling.mode = SamplingMode::Prioritized;
+  opt.target_fps = 0.001;
+  std::vector<ImageRGBA> images;
+  const auto frames = render_camera_path(scene.vol, scene.tf, {}, cams, nullptr, opt,
+                                         [&](const PathFrame&, const ImageRGBA& img) { images.push_back(img); });
+  ASSERT_EQ(frames.size(), 3u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const volume::RayCaster caster(scene.vol, scene.tf, cams[i]);
+    const volume::RenderResult full = volume::render_full(caster);
+    EXPECT_EQ(frames[i].rays_traced, frames[i].full_rays) << "frame " << i;
+    EXPECT_EQ(images[i].pixels, full.image.pixels) << "frame " << i << " must be the full render";
+  }
+  EXPECT_GT(frames[2].rays_traced, 0u);
+}
+
 TEST(RenderCameraPath, RequestHandsEveryFrameToTheSink) {
   const PathScene scene;
   const std::string dir = test::make_temp_dir("camera_path_request");
