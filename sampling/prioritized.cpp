@@ -45,17 +45,6 @@ ObjectCounts scan_importance(const ImageF& importance, int spacing) {
   return c;
 }
 
-// Background or (with `traced`) traced pixels: what the reconstruction must not change.
-ImageMask background_known(const ImageF& importance, const ImageMask* traced = nullptr) {
-  ImageMask known(importance.width, importance.height, 0);
-  parallel_rows(importance.height, [&](int y) {
-    const std::size_t row = std::size_t(y) * std::size_t(importance.width);
-    for (std::size_t i = row; i < row + std::size_t(importance.width); ++i)
-      known.pixels[i] = importance.pixels[i] < 0 || (traced && traced->pixels[i]) ? 1 : 0;
-  });
-  return known;
-}
-
 void mark(Span<const std::uint32_t> pixels, ImageMask& mask) {
   for (std::uint32_t p : pixels) mask.pixels[p] = 1;
 }

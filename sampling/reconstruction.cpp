@@ -207,6 +207,16 @@ void fill_hierarchically(ImageRGBA& image, const ImageMask& known, ImageMask& av
 
 }  // namespace
 
+ImageMask background_known(const ImageF& importance, const ImageMask* traced) {
+  ImageMask known(importance.width, importance.height, 0);
+  parallel_rows(importance.height, [&](int y) {
+    const std::size_t row = std::size_t(y) * std::size_t(importance.width);
+    for (std::size_t i = row; i < row + std::size_t(importance.width); ++i)
+      known.pixels[i] = importance.pixels[i] < 0 || (traced && traced->pixels[i]) ? 1 : 0;
+  });
+  return known;
+}
+
 void reconstruct_fractal(ImageRGBA& image, const ImageMask& known, const FractalPattern& pattern,
                          Interpolation interpolation) {
   const int w = image.width, h = image.height, spacing = pattern.base_spacing;

@@ -27,6 +27,9 @@ enum class Interpolation { Linear, Cubic };
 void reconstruct_fractal(ImageRGBA& image, const ImageMask& known, const FractalPattern& pattern,
                          Interpolation interpolation = Interpolation::Linear);
 
+/// Background pixels (importance < 0) or, with `traced`, traced ones: what the reconstruction must not change.
+ImageMask background_known(const ImageF& importance, const ImageMask* traced = nullptr);
+
 /// A regular sampling grid for the subsample baseline: pixel columns xs and rows ys (increasing).
 struct SampleGrid {
   std::vector<int> xs, ys;

@@ -9,6 +9,7 @@
 #include "core/parallel.h"
 #include "core/timer.h"
 #include "sampling/ray_order.h"
+#include "sampling/reconstruction.h"
 
 namespace raysift::sampling {
 namespace {
@@ -646,12 +647,7 @@ RefinementResult trace_refined(const ImageF& importance, const FractalPattern& p
       result.rays += more.size();
       if (more.size() < pixels.size()) break;
     }
-    if (known) {
-      *known = ImageMask(w, importance.height, 0);
-      parallel_for_each(known->size(), [&](std::size_t i) {
-        known->pixels[i] = importance.pixels[i] < 0 || traced.pixels[i] ? 1 : 0;
-      }, true, std::size_t(1) << 14);
-    }
+    if (known) *known = background_known(importance, &traced);
     return result;
   }
 

@@ -142,7 +142,6 @@ TEST(Refinement, UniformLevelsAreTracedWholeAndTheRestGoesToTheEdge) {
   EXPECT_GT(near / near_n, 2 * far / far_n) << "the rays beyond the uniform lattice must go to the edge";
 }
 
-// Rounds of several thousand rays span many of the parallel offer chunks (1024 sources each).
 // Under a deadline the level after the uniform ones is ranked once by its parents' contrast: 12 virtual ms at 10 us
 // a ray hold levels 0-3 (864 rays) and part of level 4 (864 pixels), and every level-4 pixel whose parents straddle
 // the edge comes before any whose parents agree.
@@ -183,6 +182,7 @@ TEST(Refinement, UnderADeadlineTheNextLevelIsTracedInContrastOrder) {
   EXPECT_LT(level4_traced, level4) << "the deadline must cut level 4";
 }
 
+// Rounds of several thousand rays span many of the parallel offer chunks (1024 sources each).
 TEST(Refinement, OneAndTwoThreadsTraceTheSamePixelsInLargeRounds) {
   constexpr int w = 320, h = 240;
   ImageF imp(w, h, -1.0f);
