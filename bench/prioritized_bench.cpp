@@ -13,7 +13,7 @@
 //    target and each frame's SSIM_object and FLIP_object against the full render of that frame.
 // Scenes: engine CT opaque and translucent (second view), MRI head opaque and translucent, and with --unseen
 // the smoke VDB from the shared datasets (bench/bench_data.h) with a TF written once (normalised to its value range) and never tuned.
-// Usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--linear] [--floor F] [--line-weight W]
+// Usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--interpolation linear|cubic|edge-directed] [--floor F] [--line-weight W]
 //                          [--alpha-weight W] [--uniform-share K] [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N] [--budget-only]
 //                          [--spacing S] [--max-budget-share K] [--orbit-only] [--orbit-frames N]
 #include <algorithm>
@@ -430,7 +430,7 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--quick")) quick = true;
     else if (!std::strcmp(argv[i], "--unseen")) unseen = true;
     else if (!std::strcmp(argv[i], "--no-refine")) setup.sampling.refinement.enabled = false;
-    else if (!std::strcmp(argv[i], "--linear")) setup.sampling.interpolation = sampling::Interpolation::Linear;
+    else if (!std::strcmp(argv[i], "--interpolation") && more) setup.sampling.interpolation = sampling::parse_interpolation(argv[++i]);
     else if (!std::strcmp(argv[i], "--floor") && more) setup.sampling.refinement.floor = std::stof(argv[++i]);
     else if (!std::strcmp(argv[i], "--line-weight") && more) setup.sampling.refinement.line_weight = std::stof(argv[++i]);
     else if (!std::strcmp(argv[i], "--alpha-weight") && more) setup.sampling.refinement.alpha_weight = std::stof(argv[++i]);
@@ -446,7 +446,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--orbit-frames") && more) setup.orbit_frames = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--orbit-csv") && more) setup.orbit_csv = argv[++i];
     else {
-      std::fprintf(stderr, "usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--linear] [--floor F] "
+      std::fprintf(stderr, "usage: prioritized_bench [--quick] [--scenes a,b] [--unseen] [--no-refine] [--interpolation linear|cubic|edge-directed] [--floor F] "
                            "[--line-weight W] [--alpha-weight W] [--uniform-share K] [--alpha a00,...,a02] [--budget-frames N] [--overhead-only N] [--budget-only] [--spacing S] [--max-budget-share K] [--orbit-only] [--orbit-frames N] [--orbit-csv FILE]\n");
       return 2;
     }
@@ -457,7 +457,7 @@ int main(int argc, char** argv) {
   std::printf("prioritized_bench: %dx%d, phong, features %s, %s reconstruction, refinement %s (floor %g, "
               "line weight %g, alpha weight %g, uniform share %g), alpha %g,%g,%g,%g,%g,%g, base spacing %d\n", width, height,
               sampling::kDefaultFeatures,
-              setup.sampling.interpolation == sampling::Interpolation::Cubic ? "cubic" : "linear",
+              sampling::interpolation_name(setup.sampling.interpolation),
               setup.sampling.refinement.enabled ? "on" : "off",
               setup.sampling.refinement.floor, setup.sampling.refinement.line_weight,
               setup.sampling.refinement.alpha_weight, setup.sampling.refinement.uniform_share, a[0], a[1], a[2], a[3], a[4],

@@ -359,7 +359,8 @@ sampling::SamplingOptions lockstep_options(const sampling::SamplingOptions& give
     return t;
   };
   if (o.budget_ms > 0 && o.reconstruct_reserve_ms < 0) {
-    o.reconstruct_reserve_ms = is_root() ? sampling::estimate_reconstruct_ms(width, height, o.base_spacing) : 0.0;
+    o.reconstruct_reserve_ms = is_root() ? sampling::estimate_reconstruct_ms(width, height, o.base_spacing, o.interpolation)
+                                        : 0.0;
     broadcast_value(o.reconstruct_reserve_ms);
   }
   return o;

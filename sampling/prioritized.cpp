@@ -4,8 +4,10 @@
 #include <cmath>
 #include <map>
 #include <mutex>
+#include <tuple>
 
 #include "core/errors.h"
+#include "core/hash.h"
 #include "core/parallel.h"
 #include "sampling/reconstruction.h"
 
@@ -82,7 +84,8 @@ std::size_t ray_target(const SamplingOptions& options, std::size_t object, std::
 
 double reconstruct_reserve(const SamplingOptions& options, int w, int h, std::size_t object_pixels) {
   return options.reconstruct_reserve_ms >= 0 ? options.reconstruct_reserve_ms
-                                             : estimate_reconstruct_ms(w, h, options.base_spacing, object_pixels);
+                                             : estimate_reconstruct_ms(w, h, options.base_spacing, options.interpolation,
+                                                                                object_pixels);
 }
 
 // Budget mode with the a priori bucketed queue (RP paper section 5).
@@ -164,28 +167,35 @@ ImageF control_importance(const ImageF& importance) {
   return out;
 }
 
-double estimate_reconstruct_ms(int width, int height, int base_spacing, std::size_t object_pixels) {
-  // Measured once per (crop, spacing) and process: the estimate must not cost a reconstruction per frame. Two
-  // per-pixel costs: an object pixel with only level 0 traced around it (the worst case), and a known pixel
-  // (background: only scanned). Each is the fastest of 3 runs: the first run pays for page faults on the fresh
-  // crop, which later frames do not (their buffers are reused), and a reserve sized by it wasted a third of a
-  // 15 ms budget.
+double estimate_reconstruct_ms(int width, int height, int base_spacing, Interpolation interpolation,
+                               std::size_t object_pixels) {
+  // Measured once per (crop, spacing, rule) and process: the estimate must not cost a reconstruction per frame.
+  // Two per-pixel costs: an object pixel with only level 0 traced around it (the worst case: its level-0 samples
+  // are noise, so every edge-directed test passes), and a known pixel (background: only scanned). Each is the
+  // fastest of 3 runs: the first run pays for page faults on the fresh crop, which later frames do not (their
+  // buffers are reused), and a reserve sized by it wasted a third of a 15 ms budget.
   struct PixelCosts {
     double object_ms, known_ms;
   };
   static std::mutex mutex;
-  static std::map<std::pair<int, int>, PixelCosts> costs;  // key (crop side, spacing)
+  static std::map<std::tuple<int, int, Interpolation>, PixelCosts> costs;  // key (crop side, spacing, rule)
   const int side = std::min(256, std::max(16, std::min(width, height)));
   std::lock_guard<std::mutex> lock(mutex);
-  auto it = costs.find({side, base_spacing});
+  auto it = costs.find({side, base_spacing, interpolation});
   if (it == costs.end()) {
     const FractalPattern pattern = make_fractal_pattern(side, side, base_spacing);
+    ImageRGBA samples(side, side);
+    for (std::size_t i = 0; i < samples.pixels.size(); ++i) {
+      const std::uint64_t bits = mix64(i);
+      samples.pixels[i] = Rgba{float(bits & 0xff) / 255, float((bits >> 8) & 0xff) / 255,
+                               float((bits >> 16) & 0xff) / 255, 1.0f};
+    }
     auto ms_per_pixel = [&](const ImageMask& known) {
-      ImageRGBA image(side, side);
       double best_ms = 1e300;
       for (int run = 0; run < 3; ++run) {
+        ImageRGBA image = samples;
         const Timer timer;
-        reconstruct_fractal(image, known, pattern);
+        reconstruct_fractal(image, known, pattern, interpolation);
         best_ms = std::min(best_ms, timer.elapsed_ms());
       }
       return best_ms / double(side * side);
@@ -193,7 +203,7 @@ double estimate_reconstruct_ms(int width, int height, int base_spacing, std::siz
     ImageMask level0(side, side, 0);
     for (std::size_t i = 0; i < level0.size(); ++i) level0.pixels[i] = pattern.level.pixels[i] == 0 ? 1 : 0;
     const PixelCosts measured{ms_per_pixel(level0), ms_per_pixel(ImageMask(side, side, 1))};
-    it = costs.emplace(std::make_pair(side, base_spacing), measured).first;
+    it = costs.emplace(std::make_tuple(side, base_spacing, interpolation), measured).first;
   }
   const double pixels = double(width) * double(height), object = std::min(pixels, double(object_pixels));
   return it->second.object_ms * object + it->second.known_ms * (pixels - object);
@@ -300,7 +310,7 @@ SampledFrame ProgressiveSampler::next_frame(const TraceBatch& trace) {
                            : last_reconstruct_ms_ >= 0
                                ? 1.25 * last_reconstruct_ms_
                                : estimate_reconstruct_ms(samples_.width, samples_.height, options_.base_spacing,
-                                                         queue_.object_pixels);
+                                                         options_.interpolation, queue_.object_pixels);
     const double deadline = options_.budget_ms - reserve;
     frame.budget_too_small = begin == 0 && now() > deadline;
     next_ += trace_until(Span<const std::uint32_t>(all.data() + next_, all.size() - next_), trace, samples_, now,

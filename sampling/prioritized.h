@@ -39,7 +39,7 @@ struct SamplingOptions {
   /// Prioritized fraction and budget modes: place rays from the traced level-0 samples (refinement.h).
   RefinementOptions refinement;
   /// How the prioritized modes fill untraced pixels (reconstruction.h).
-  Interpolation interpolation = Interpolation::Cubic;
+  Interpolation interpolation = Interpolation::EdgeDirected;
   int base_spacing = 8;   ///< fractal level-0 spacing, px (power of two)
   int buckets = 256;      ///< priority buckets of the budget/progressive queue
   std::uint64_t seed = 1;
@@ -76,10 +76,10 @@ ImageF control_importance(const ImageF& importance);
 SampledFrame render_sampled(const ImageF& importance, const TraceBatch& trace, const SamplingOptions& options,
                             double elapsed_before_ms = 0);
 
-/// \brief Wall time of one fractal reconstruction of a frame of this size whose `object_pixels` have only level 0
-/// traced (the worst case) and the rest are background, from per-pixel costs measured once per process on a
-/// crop of at most 256x256 (warm: the fastest of 3 runs).
-double estimate_reconstruct_ms(int width, int height, int base_spacing,
+/// \brief Wall time of one fractal reconstruction by `interpolation` of a frame of this size whose `object_pixels`
+/// have only level 0 traced (the worst case) and the rest are background, from per-pixel costs measured once per
+/// process on a crop of at most 256x256 (warm: the fastest of 3 runs).
+double estimate_reconstruct_ms(int width, int height, int base_spacing, Interpolation interpolation,
                                std::size_t object_pixels = std::numeric_limits<std::size_t>::max());
 
 /// \brief Budget mode over a sequence of frames: what to pass as SamplingOptions::reconstruct_reserve_ms.

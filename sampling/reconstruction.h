@@ -6,6 +6,7 @@
 /// 45°-rotated diamond) whose enclosing cell has all four corners available. Square cells that would
 /// reach past the right/bottom border are shifted inside and extrapolate, so an affine image is
 /// reproduced exactly everywhere. The subsample baseline upscales a regular grid bilinearly.
+#include <string>
 #include <vector>
 
 #include "core/image.h"
@@ -21,8 +22,16 @@ namespace raysift::sampling {
 ///      they are not, pixels without any complete cell keep the mean of the known corners found (or 0).
 /// Output values are clamped to [0,1].
 /// Linear: bilinear cells (the RP paper's rule); Cubic: the 4-point interpolatory rule where its stencil is
-/// available, clamped to the cell's corner range (sharper shading, no ringing at edges).
-enum class Interpolation { Linear, Cubic };
+/// available, clamped to the cell's corner range (sharper shading, no ringing at edges); EdgeDirected: Cubic,
+/// with each edge midpoint between two known (traced or background) ends, beside at least one known square
+/// centre, whose four nearest neighbours differ taken as the blend of the 4-point rule along and across the
+/// edge, weighted by the variation in each direction (an edge is followed, not crossed).
+/// All three reproduce an affine image exactly.
+enum class Interpolation { Linear, Cubic, EdgeDirected };
+
+/// "linear", "cubic", "edge-directed". \throw InvalidInput for any other name.
+Interpolation parse_interpolation(const std::string& name);
+const char* interpolation_name(Interpolation interpolation);
 
 void reconstruct_fractal(ImageRGBA& image, const ImageMask& known, const FractalPattern& pattern,
                          Interpolation interpolation = Interpolation::Linear);
