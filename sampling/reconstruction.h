@@ -28,6 +28,8 @@ namespace raysift::sampling {
 /// edge, weighted by the variation in each direction (an edge is followed, not crossed).
 /// All three reproduce an affine image exactly.
 enum class Interpolation { Linear, Cubic, EdgeDirected };
+inline constexpr Interpolation kInterpolations[] = {Interpolation::Linear, Interpolation::Cubic,
+                                                    Interpolation::EdgeDirected};
 
 /// "linear", "cubic", "edge-directed". \throw InvalidInput for any other name.
 Interpolation parse_interpolation(const std::string& name);

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 #include "apps/raysift/cli_checks.h"
@@ -103,8 +104,9 @@ void add_render_options(CLI::App& sub, RenderCliOptions& o, PathCliOptions& p, c
                  "prioritized: prepared feature mesh (e.g. from raysift mesh) instead of extracting iso-surfaces");
   sampled->add_flag("--no-refine", o.no_refine,
                "prioritized: place rays by the a priori queue only (no contrast refinement from level 0)");
-  sampled->add_option("--interpolation", o.interpolation, "sampled modes: reconstruction rule")
-      ->check(CLI::IsMember({"linear", "cubic", "edge-directed"}))->capture_default_str();
+  std::map<std::string, sampling::Interpolation> interpolations;
+  for (sampling::Interpolation i : sampling::kInterpolations) interpolations[sampling::interpolation_name(i)] = i;
+  add_choice(*sampled, "--interpolation", o.interpolation, interpolations, "sampled modes: reconstruction rule");
   sampled->add_option("--feature-cache", o.feature_cache,
                  "prioritized: directory caching the feature geometry across runs (keyed by volume, TF, options)");
   sub.footer(
@@ -204,7 +206,7 @@ RenderInputs build_inputs(const RenderCliOptions& o, const CommonOptions& common
   in.sampled.sampling.ray_fraction = o.ray_fraction;
   in.sampled.sampling.budget_ms = o.budget_ms;
   in.sampled.sampling.refinement.enabled = !o.no_refine;
-  in.sampled.sampling.interpolation = sampling::parse_interpolation(o.interpolation);
+  in.sampled.sampling.interpolation = o.interpolation;
   in.sampled.sampling.seed = common.seed;
   in.sampled.progressive_frames = o.progressive;
   in.sampled.feature_mesh = o.feature_mesh;

@@ -41,7 +41,7 @@ struct RenderCliOptions {
   std::string feature_mesh;
   std::string feature_cache;  ///< directory of the on-disk feature cache; empty = memory only
   bool no_refine = false;
-  std::string interpolation = sampling::interpolation_name(sampling::SamplingOptions{}.interpolation);
+  sampling::Interpolation interpolation = sampling::SamplingOptions{}.interpolation;
 };
 
 /// Everything a mode needs, built once from flags and scene.

@@ -240,7 +240,7 @@ TEST(Refinement, AFrameIsTheSameAfterFramesOfOtherSizes) {
 TEST(Refinement, RefinedFrameOfAnAffineImageIsExact) {
   // The samples are affine, so refinement and either reconstruction must give the image back exactly.
   ImageF imp(kW, kH, 0.0f);
-  for (Interpolation mode : {Interpolation::Linear, Interpolation::Cubic, Interpolation::EdgeDirected}) {
+  for (Interpolation mode : kInterpolations) {
     SamplingOptions o;
     o.ray_fraction = 0.15;
     o.interpolation = mode;
