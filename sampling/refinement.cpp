@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdlib>
 #include <cmath>
 #include <vector>
 
@@ -146,6 +147,23 @@ class CornerSpread {
  private:
   std::array<int, 4> lo_{255, 255, 255, 255}, hi_{0, 0, 0, 0};
 };
+
+// How far a cell's four parents are from an affine image, which every interpolation rule reproduces exactly (the
+// parents in parent_offsets() order: opposite pairs are 0-3 / 1-2 for a square's corners, 0-1 / 2-3 for an edge
+// midpoint's diamond): half the largest per-channel difference of the two pairs' sums, alpha weighted as in
+// CornerSpread, in [0, 1]. A smooth shading gradient has a large contrast but no residual; a curved edge, a
+// highlight or a texture has both. A straight edge parallel to a pair's axis is affine on the four parents; the
+// next level's cells, whose parents lie on both sides of it, see it. Ranking by it instead of the contrast met
+// more equal-time targets on every scene of the bench (docs/prioritized.md, session 14); the rounds' offers keep
+// the contrast, which measured better there.
+float affine_residual(const std::array<Percept, 4>& parents, int level, float alpha_weight) {
+  const bool square = level % 2 == 1;
+  const Percept &a = parents[0], &b = parents[square ? 3 : 1], &c = parents[square ? 1 : 2], &d = parents[square ? 2 : 3];
+  int colour = 0;
+  for (int k = 0; k < 3; ++k) colour = std::max(colour, std::abs(int(a[k]) + int(b[k]) - int(c[k]) - int(d[k])));
+  const int alpha = std::abs(int(a[3]) + int(b[3]) - int(c[3]) - int(d[3]));
+  return std::max(float(colour), alpha_weight * float(alpha)) * (0.5f / 255.0f);
+}
 
 // What an offer reads and writes of the child. The offers outlive the frame (frame_buffer, next_epoch): `priority`
 // counts only when the epoch is the frame's, so a new frame bumps the epoch instead of clearing 10 MB.
@@ -581,8 +599,8 @@ std::vector<std::uint32_t> trace_first(const ImageF& importance, const FractalPa
 
 
 // Under a deadline, after the uniform levels: `pixels`, the object pixels of `level`, all of whose parents are
-// traced (the levels before it were traced whole) or background, ranked once by the contrast of those parents plus
-// the line importance (the refiner's priority, whose floor and level share are the same for all of them), and
+// traced (the levels before it were traced whole) or background, ranked once by the affine residual of those
+// parents plus the line importance (the floor and level share of the refiner's priority are the same for all), and
 // traced in that order in slices of a quarter of what the time left holds, each in hashed tile order, until the
 // deadline. No rounds and no offers: every priority is known before the first ray (docs/prioritized.md, "Budget
 // mode without rounds"). \return the pixels traced; `rays_per_ms` ends as the rate of the last slice.
@@ -598,11 +616,22 @@ std::vector<std::uint32_t> trace_ranked_until(const std::vector<std::uint32_t>& 
   parallel_for_each(pixels.size(), [&](std::size_t i) {
     const std::uint32_t p = pixels[i];
     const int x = int(p % std::uint32_t(w)), y = int(p / std::uint32_t(w));
-    CornerSpread spread;  // a background parent's image value, and percept, is 0
-    for (const auto& o : offsets)
-      if (x + o[0] >= 0 && y + o[1] >= 0 && x + o[0] < w && y + o[1] < h) spread.add(percept_of(image(x + o[0], y + o[1])));
-    const float priority =
-        std::min(3.9f, spread.contrast(options.alpha_weight) + options.line_weight * importance.pixels[p]);
+    // A background parent's image value, and percept, is 0. A cell cut by the image border has no affine test:
+    // the contrast of the parents inside stands in.
+    std::array<Percept, 4> parents{};
+    CornerSpread spread;
+    bool inside = true;
+    for (std::size_t k = 0; k < 4; ++k) {
+      const int px = x + offsets[k][0], py = y + offsets[k][1];
+      if (px < 0 || py < 0 || px >= w || py >= h) {
+        inside = false;
+        continue;
+      }
+      parents[k] = percept_of(image(px, py));
+      spread.add(parents[k]);
+    }
+    const float error = inside ? affine_residual(parents, level, options.alpha_weight) : spread.contrast(options.alpha_weight);
+    const float priority = std::min(3.9f, error + options.line_weight * importance.pixels[p]);
     const auto rank = std::uint32_t(0xFFFFFu - std::uint32_t(priority * float(1 << 18)));
     keys[i] = std::uint64_t(rank << 12 | (pixel_hash(p, seed) & 0xFFFu)) << 32 | p;
   }, true, std::size_t(4096));

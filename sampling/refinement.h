@@ -7,8 +7,9 @@
 /// share of the frame one ray of that level covers. The floor keeps coverage even where the samples agree
 /// (subsampling's strength on shaded texture). With a ray count, candidates are traced in rounds of the highest
 /// priorities; each round's samples raise or lower their children's priorities. Under a deadline there are no
-/// rounds: after the uniform levels, the next level's pixels are ranked once by the same contrast and traced in
-/// that order until the deadline (the rounds' offers cost more of a frame's time than their better placement
+/// rounds: after the uniform levels, the next level's pixels are ranked once by their parents' departure from an
+/// affine image (where every interpolation rule is exact) plus the line term, and traced in that order until the
+/// deadline (the rounds' offers cost more of a frame's time than their better placement
 /// gained, docs/prioritized.md "Budget mode without rounds"). Every traced cell's corners are traced, so the
 /// hierarchical reconstruction (reconstruction.h) builds on them.
 #include <cstdint>

@@ -145,7 +145,7 @@ TEST(Refinement, UniformLevelsAreTracedWholeAndTheRestGoesToTheEdge) {
 // Under a deadline the level after the uniform ones is ranked once by its parents' contrast: 12 virtual ms at 10 us
 // a ray hold levels 0-3 (864 rays) and part of level 4 (864 pixels), and every level-4 pixel whose parents straddle
 // the edge comes before any whose parents agree.
-TEST(Refinement, UnderADeadlineTheNextLevelIsTracedInContrastOrder) {
+TEST(Refinement, UnderADeadlineTheNextLevelTracesTheStepEdgeFirst) {
   StepEdgeRun edge;
   std::atomic<std::int64_t> clock_us{0};
   const ElapsedMs now = [&clock_us] { return double(clock_us.load()) / 1000.0; };
@@ -303,6 +303,45 @@ TEST(Refinement, KnownMaskIsBackgroundOrTracedAlsoWhenADeadlineCutsASlice) {
     EXPECT_GT(n_traced, 0u);
     EXPECT_LT(n_traced, object_pixels(imp));
   }
+}
+
+// A steep ramp whose square root is affine (the contrast's percepts: every 4-px cell has a spread of 12 units in
+// green) under a faint red disc (a step of about 9 units): the contrast of a cell on the disc's rim is no larger than
+// anywhere else, but its departure from an affine image is.
+Rgba ramp_under_disc(int x, int y) {
+  const float green = 0.05f + 0.012f * float(y);
+  const float red = std::hypot(x + 0.5 - 48.0, y + 0.5 - 36.0) < 20 ? 0.335f : 0.3f;
+  return {red * red, green * green, 0.25f, 1};
+}
+
+TEST(Refinement, UnderADeadlineTheRankedLevelTracesCurvedEdgesBeforeASteepRamp) {
+  const ImageF imp(kW, kH, 0.0f);
+  const FractalPattern p = make_fractal_pattern(kW, kH, 8);
+  std::atomic<std::int64_t> clock_us{0};
+  const ElapsedMs now = [&clock_us] { return double(clock_us.load()) / 1000.0; };
+  RefinementStop stop;
+  stop.now = &now;
+  // Levels 0-2 (the 4-px lattice, 432 rays) take 4.32 ms at 10 us a ray; level 3 (432 more) does not fit in what
+  // is left, so it is ranked, and about 256 of its rays are traced.
+  stop.deadline_ms = 6.9;
+  ImageRGBA image(kW, kH);
+  ImageMask traced(kW, kH, 0);
+  trace_refined(imp, p, {}, stop, 1, tracer(ramp_under_disc, nullptr, &clock_us), image, traced);
+  auto inside = [](int x, int y) { return std::hypot(x + 0.5 - 48.0, y + 0.5 - 36.0) < 20; };
+  int rim = 0, level3 = 0;
+  for (int y = 2; y < kH; y += 4)
+    for (int x = 2; x < kW; x += 4) {
+      ASSERT_EQ(p.level(x, y), 3);
+      level3 += traced(x, y);
+      if (x + 2 >= kW || y + 2 >= kH) continue;
+      // A rim cell that is not affine on its corners: an odd number of them inside the disc.
+      const int corners_inside = inside(x - 2, y - 2) + inside(x + 2, y - 2) + inside(x - 2, y + 2) + inside(x + 2, y + 2);
+      if (corners_inside % 2 == 0) continue;
+      ++rim;
+      EXPECT_TRUE(traced(x, y)) << "rim cell centre " << x << "," << y << " left for the ramp";
+    }
+  EXPECT_GT(rim, 20);
+  EXPECT_LT(level3, 24 * 18);  // the level was cut: the ranking decided
 }
 
 }  // namespace
