@@ -6,8 +6,12 @@
 //    |alpha - alpha_full| over object pixels, as in Weiss et al. 2020); printed as ratios to subsampling.
 //  * Table 1: per-step frame times at 1440x900 (importance, priorities, trace, reconstruct) at 10 % of the rays.
 //  * Fig. 7: quality vs guaranteed frame rate: budget mode at 2, 4, 8 and 16 times the full render's rate.
-// Saliency needs a camera path (it is warped from the previous frame) and is not part of this still-frame run.
-// Usage: paper_eval_bench [--quick]   (--quick: 720x450)
+// The saliency classifier is the RP paper's image-space one: the saliency of the previous frame of the same still
+// view (the control frame at the same ray fraction, as the user saw it) warped to this frame, which for a still view
+// is the identity (the full render's depth places it); its time (saliency + warp) is charged to the frame.
+// --csv FILE writes every ratio for scripts/plot_paper_eval.py, which draws docs/figures/paper_eval_fig5.png and
+// paper_eval_fig7.png.
+// Usage: paper_eval_bench [--quick] [--csv FILE]   (--quick: 720x450)
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -22,6 +26,7 @@
 #include "core/timer.h"
 #include "features/importance.h"
 #include "isosurface/feature_geometry.h"
+#include "sampling/camera_path.h"
 #include "sampling/metrics.h"
 #include "sampling/volume_sampling.h"
 #include "volume/raycaster.h"
@@ -41,11 +46,16 @@ struct Scene3 {
 struct Classifier {
   const char* name;
   const char* classes;  ///< --features list, "none" = control
+  bool saliency;        ///< the previous frame's saliency instead of lines
 };
 
-const Classifier kClassifiers[] = {{"contours", "contours"},       {"silhouettes", "silhouettes"},
-                                   {"sugg+highl", "suggestive,highlights"}, {"ridges+valleys", "ridges,valleys"},
-                                   {"all", "all"},                 {"none", "none"}};
+const Classifier kClassifiers[] = {{"contours", "contours", false},
+                                   {"silhouettes", "silhouettes", false},
+                                   {"sugg+highl", "suggestive,highlights", false},
+                                   {"ridges+valleys", "ridges,valleys", false},
+                                   {"saliency", "none", true},
+                                   {"all", "all", false},
+                                   {"none", "none", false}};
 const double kFractions[] = {0.02, 0.05, 0.1, 0.2, 0.4};
 
 struct Score {
@@ -60,9 +70,41 @@ double alpha_error(const ImageRGBA& ref, const ImageRGBA& img, const sampling::I
   return n ? sum / double(n) : 0.0;
 }
 
+Score score(const ImageRGBA& ref, const ImageRGBA& image, double ms, const sampling::ImageMask& object) {
+  const sampling::Comparison c = sampling::compare_images(ref, image, &object);
+  return {c.object.flip, 1.0 - c.object.ssim, alpha_error(ref, image, object), ms};
+}
+
 Score score(const ImageRGBA& ref, const sampling::VolumeFrame& frame, const sampling::ImageMask& object) {
-  const sampling::Comparison c = sampling::compare_images(ref, frame.image, &object);
-  return {c.object.flip, 1.0 - c.object.ssim, alpha_error(ref, frame.image, object), frame.total_ms};
+  return score(ref, frame.image, frame.total_ms, object);
+}
+
+/// The full render of a view: what every frame is scored against, and (depth) where a still view's previous
+/// frame lies.
+struct FullRender {
+  ImageRGBA image;
+  ImageF depth;
+  sampling::ImageMask object;
+};
+
+/// A frame of `o` whose importance is the saliency of the previous frame of this still view (the control at the
+/// same fraction); the saliency and its warp are part of the frame time.
+Score saliency_frame(const volume::RayCaster& caster, const FullRender& full, const sampling::SamplingOptions& o) {
+  sampling::PreviousFrame previous{caster.camera().spec(), sampling::render_volume_frame(caster, nullptr, {}, o).image,
+                                   full.depth};
+  sampling::PathFeatureOptions features;
+  features.use_saliency = true;
+  const Timer t;
+  const ImageF importance = sampling::path_frame_importance(caster, nullptr, features, &previous, o.base_spacing);
+  sampling::SampledFrame f = sampling::render_sampled(importance, sampling::caster_trace_batch(caster), o, t.elapsed_ms());
+  const ImageRGBA image = sampling::composite_frame(std::move(f.image), caster.options().background);
+  return score(full.image, image, t.elapsed_ms(), full.object);
+}
+
+/// One plotted point: `basis` is equal_time or equal_rays (Fig. 5) or budget (Fig. 7, x = the speed-up).
+void csv_row(std::FILE* csv, const char* figure, const std::string& scene, const char* series, double x,
+             const char* basis, double flip, double dssim, double alpha) {
+  if (csv) std::fprintf(csv, "%s,%s,%s,%g,%s,%.4f,%.4f,%.4f\n", figure, scene.c_str(), series, x, basis, flip, dssim, alpha);
 }
 
 sampling::ImageMask object_mask(const ImageRGBA& full) {
@@ -85,8 +127,7 @@ Score subsample_at(const std::vector<Score>& curve, double ms, bool& clamped) {
 }
 
 /// Subsampling at fractions spanning the prioritized frames' times, timed in the same run (best of 3).
-std::vector<Score> subsample_curve(const volume::RayCaster& caster, const ImageRGBA& full,
-                                   const sampling::ImageMask& object) {
+std::vector<Score> subsample_curve(const volume::RayCaster& caster, const FullRender& full) {
   std::vector<Score> curve;
   for (const double f : {0.01, 0.02, 0.035, 0.05, 0.075, 0.1, 0.15, 0.2, 0.3, 0.4, 0.55, 0.7}) {
     sampling::SamplingOptions o;
@@ -94,7 +135,7 @@ std::vector<Score> subsample_curve(const volume::RayCaster& caster, const ImageR
     o.ray_fraction = f;
     Score best;
     for (int r = 0; r < 3; ++r) {
-      const Score sc = score(full, sampling::render_volume_frame(caster, nullptr, {}, o), object);
+      const Score sc = score(full.image, sampling::render_volume_frame(caster, nullptr, {}, o), full.object);
       if (r == 0 || sc.ms < best.ms) best = sc;
     }
     curve.push_back(best);
@@ -108,8 +149,10 @@ std::vector<Score> subsample_curve(const volume::RayCaster& caster, const ImageR
   return curve;
 }
 
+double ratio(double a, double b) { return b > 0 ? a / b : 1.0; }
+
 void fig5(const Scene3& s, const volume::RayCaster& caster, const isosurface::FeatureGeometry& geometry,
-          const ImageRGBA& full, const sampling::ImageMask& object, const std::vector<Score>& curve) {
+          const FullRender& full, const std::vector<Score>& curve, std::FILE* csv) {
   std::printf("\nFig. 5 analogue, %s: prioritized / subsample error (FLIP | 1-SSIM | alpha MAE); first at EQUAL "
               "FRAME TIME (subsampling interpolated on its time->error curve, * = outside it), then at equal rays\n",
               s.name.c_str());
@@ -123,25 +166,29 @@ void fig5(const Scene3& s, const volume::RayCaster& caster, const isosurface::Fe
     for (const double fraction : kFractions) {
       sampling::SamplingOptions o;
       o.ray_fraction = fraction;
-      const Score p = score(full, sampling::render_volume_frame(caster, &geometry, features, o), object);
+      const Score p = c.saliency ? saliency_frame(caster, full, o)
+                                 : score(full.image, sampling::render_volume_frame(caster, &geometry, features, o),
+                                         full.object);
       o.mode = sampling::SamplingMode::Subsample;
-      const Score rays = score(full, sampling::render_volume_frame(caster, nullptr, {}, o), object);
+      const Score rays = score(full.image, sampling::render_volume_frame(caster, nullptr, {}, o), full.object);
       bool clamped = false;
       const Score time = subsample_at(curve, p.ms, clamped);
-      auto ratio = [](double a, double b) { return b > 0 ? a / b : 1.0; };
       std::printf(" | %.2f %.2f %.2f%s / %.2f %.2f %.2f", ratio(p.flip, time.flip), ratio(p.dssim, time.dssim),
                   ratio(p.alpha, time.alpha), clamped ? "*" : " ", ratio(p.flip, rays.flip),
                   ratio(p.dssim, rays.dssim), ratio(p.alpha, rays.alpha));
+      csv_row(csv, "fig5", s.name, c.name, 100 * fraction, clamped ? "equal_time_clamped" : "equal_time",
+              ratio(p.flip, time.flip), ratio(p.dssim, time.dssim), ratio(p.alpha, time.alpha));
+      csv_row(csv, "fig5", s.name, c.name, 100 * fraction, "equal_rays", ratio(p.flip, rays.flip),
+              ratio(p.dssim, rays.dssim), ratio(p.alpha, rays.alpha));
     }
     std::printf("\n");
   }
 }
 
 void table1_and_fig7(const Scene3& s, const volume::RayCaster& caster, const isosurface::FeatureGeometry& geometry,
-                     const ImageRGBA& full, const sampling::ImageMask& object, double full_ms,
-                     const std::vector<Score>& curve) {
+                     const FullRender& full, double full_ms, const std::vector<Score>& curve, std::FILE* csv) {
   sampling::FeatureOptions lines;
-  lines.classes = sampling::parse_feature_list("contours,silhouettes");
+  lines.classes = sampling::parse_feature_list(sampling::kDefaultFeatures);
   sampling::SamplingOptions o;
   o.ray_fraction = 0.1;
   const sampling::VolumeFrame f = sampling::render_volume_frame(caster, &geometry, lines, o);
@@ -156,7 +203,7 @@ void table1_and_fig7(const Scene3& s, const volume::RayCaster& caster, const iso
     sampling::SamplingOptions b;
     b.budget_ms = full_ms / speedup;
     const sampling::VolumeFrame frame = sampling::render_volume_frame(caster, &geometry, lines, b);
-    const Score sc = score(full, frame, object);
+    const Score sc = score(full.image, frame, full.object);
     bool clamped = false;
     const Score sub = subsample_at(curve, sc.ms, clamped);
     std::printf("  %4.0fx (budget %6.1f ms): %6.1f ms, %5.1f%% rays, FLIP %.4f, 1-SSIM %.4f | vs subsample %.2f %.2f%s%s\n",
@@ -164,6 +211,8 @@ void table1_and_fig7(const Scene3& s, const volume::RayCaster& caster, const iso
                 100.0 * double(frame.sampled.rays_traced) / double(frame.sampled.full_rays), sc.flip, sc.dssim,
                 sc.flip / sub.flip, sc.dssim / sub.dssim, clamped ? "*" : "",
                 frame.sampled.budget_too_small ? " (budget_too_small)" : "");
+    csv_row(csv, "fig7", s.name, "prioritized", speedup, clamped ? "budget_clamped" : "budget", ratio(sc.flip, sub.flip),
+            ratio(sc.dssim, sub.dssim), ratio(sc.alpha, sub.alpha));
   }
 }
 
@@ -180,7 +229,22 @@ Scene3 bundled(const std::string& name, const std::string& stem, int w, int h) {
 
 int main(int argc, char** argv) {
   raysift::keep_freed_buffers_for_reuse();  // as the raysift program (core/heap_policy.h)
-  const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
+  bool quick = false;
+  std::string csv_path;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--quick")) quick = true;
+    else if (!std::strcmp(argv[i], "--csv") && i + 1 < argc) csv_path = argv[++i];
+    else {
+      std::fprintf(stderr, "usage: paper_eval_bench [--quick] [--csv FILE]\n");
+      return 2;
+    }
+  }
+  std::FILE* csv = csv_path.empty() ? nullptr : std::fopen(csv_path.c_str(), "w");
+  if (!csv_path.empty() && !csv) {
+    std::fprintf(stderr, "paper_eval_bench: cannot write %s\n", csv_path.c_str());
+    return 1;
+  }
+  if (csv) std::fprintf(csv, "figure,scene,series,x,basis,flip_ratio,dssim_ratio,alpha_ratio\n");
   const int w = quick ? 720 : 1440, h = quick ? 450 : 900;
   std::vector<Scene3> scenes = {bundled("engine CT", "engine_ct", w, h), bundled("MRI head", "mri_head", w, h)};
   const std::string smoke = raysift::bench::shared_dataset("openvdb_sample_smoke1_density_fog_111x222x112.vdb");
@@ -197,15 +261,17 @@ int main(int argc, char** argv) {
   for (const Scene3& s : scenes) {
     const volume::RayCaster caster(s.volume, s.tf, s.camera, render);
     const Timer t;
-    const ImageRGBA full = volume::render_full(caster).image;
+    volume::RenderResult rendered = volume::render_full(caster);
     const double full_ms = t.elapsed_ms();
+    FullRender full{std::move(rendered.image), std::move(rendered.depth), {}};
+    full.object = object_mask(full.image);
     isosurface::FeatureGeometryOptions go;
     go.view = isosurface::FeatureView{s.camera, features::ImportanceOptions{}.scale};
     const isosurface::FeatureGeometry geometry = isosurface::build_feature_geometry(s.volume, s.tf, go);
-    const sampling::ImageMask object = object_mask(full);
-    const std::vector<Score> curve = subsample_curve(caster, full, object);
-    fig5(s, caster, geometry, full, object, curve);
-    table1_and_fig7(s, caster, geometry, full, object, full_ms, curve);
+    const std::vector<Score> curve = subsample_curve(caster, full);
+    fig5(s, caster, geometry, full, curve, csv);
+    table1_and_fig7(s, caster, geometry, full, full_ms, curve, csv);
   }
+  if (csv) std::fclose(csv);
   return 0;
 }

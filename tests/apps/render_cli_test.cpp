@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <future>
@@ -149,6 +150,31 @@ TEST(RenderCli, FrameTimeAndSamplesInEveryMode) {
     EXPECT_LE(s["times_ms"]["frame"].get<double>(), s["times_ms"]["total"].get<double>() + 1e-9) << mode;
     EXPECT_GT(s["samples"].get<double>(), 0.0) << mode;
   }
+}
+
+TEST(RenderCli, BudgetStatsAndTheWarningOfABudgetBelowLevelZero) {
+  const std::string dir = make_ball_dir("render_budget_stats");
+  const std::string args = "render ball.vdb --tf tf.json --width 64 --height 48 --mode prioritized --features none ";
+  // A budget no frame can meet: the level-0 frame, a one-line warning, and the stats saying so.
+  const CliRun tiny = raysift(dir, args + "--budget-ms 0.001 -o tiny.exr --stats tiny.json");
+  ASSERT_EQ(tiny.code, 0) << tiny.err;
+  EXPECT_NE(tiny.err.find("warning: --budget-ms 0.001 is below"), std::string::npos) << tiny.err;
+  EXPECT_EQ(std::count(tiny.err.begin(), tiny.err.end(), '\n'), 1) << tiny.err;
+  const Json t = read_json_file(dir + "/tiny.json");
+  EXPECT_TRUE(t["budget_too_small"].get<bool>());
+  EXPECT_EQ(t["rays_traced"].get<std::uint64_t>(), t["level0_rays"].get<std::uint64_t>());
+  EXPECT_DOUBLE_EQ(t["budget_ms"].get<double>(), 0.001);
+  EXPECT_NEAR(t["overshoot_ms"].get<double>(), t["times_ms"]["frame"].get<double>() - 0.001, 1e-9);
+  EXPECT_TRUE(fs::exists(dir + "/tiny.exr"));
+
+  // A budget every frame meets: no warning, no overshoot counted beyond the frame's own time.
+  const CliRun ample = raysift(dir, args + "--budget-ms 100000 -o ample.exr --stats ample.json");
+  ASSERT_EQ(ample.code, 0) << ample.err;
+  EXPECT_EQ(ample.err.find("warning"), std::string::npos) << ample.err;
+  const Json a = read_json_file(dir + "/ample.json");
+  EXPECT_FALSE(a["budget_too_small"].get<bool>());
+  EXPECT_EQ(a["rays_traced"].get<std::uint64_t>(), a["full_rays"].get<std::uint64_t>());
+  EXPECT_DOUBLE_EQ(a["overshoot_ms"].get<double>(), 0.0);
 }
 
 TEST(RenderCli, FeatureCacheIsReusedAndAnUnwritableOneOnlyWarns) {
