@@ -4,7 +4,8 @@
 // prioritized_bench, and without shading as `raysift render --mode full` defaults), the whole
 // sampling::frame_importance call, and its split: background mask, lines, visibility, raster (the rest is
 // the upsampling to frame pixels). Two feature meshes per scene: build_feature_geometry's default
-// (decimate 10 %) and a 4x coarser one (decimate 2.5 %), cached as PLY under build/bench_cache/.
+// (decimate 10 %) and a 4x coarser one (decimate 2.5 %), cached as PLY under build/bench_cache/, and the one the
+// render command builds for the view ("view": level and simplification bound from the view and the importance scale).
 // Rounds interleave all measurements, so a change in machine load affects both sides of each ratio.
 //
 // Usage: importance_bench [--features LIST] [--rounds N] [--scale S] [--profile N]
@@ -228,6 +229,12 @@ int main(int argc, char** argv) {
       for (const auto& res : {std::pair<int, int>{1440, 900}, std::pair<int, int>{960, 600}}) {
         run_view(c, vol, tf, fine, "default", res.first, res.second, features, rounds);
         run_view(c, vol, tf, coarse, "coarse", res.first, res.second, features, rounds);
+        // What `raysift render --mode prioritized` builds for this view: the level and the simplification bound
+        // chosen from the view and the importance scale.
+        sampling::FeatureGeometryOptions viewed;
+        viewed.view = isosurface::FeatureView{load_camera(c, res.first, res.second), scale};
+        run_view(c, vol, tf, sampling::build_feature_geometry(vol, tf, viewed), "view", res.first, res.second, features,
+                 rounds);
       }
     }
     return 0;

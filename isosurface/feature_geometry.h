@@ -46,9 +46,10 @@ struct FeatureGeometryOptions {
   double decimate_ratio = 0.1;     ///< target faces / input faces, in (0,1] (1 = off)
   /// Grid level: 0 = chosen from `view` (1 without a view); else 1, 2, 4 or 8 voxels per cell.
   int coarsening = 0;
-  double cell_px = 2.0;            ///< automatic level: the coarsest whose cells project to <= this many importance px
+  double cell_px = 4.0;            ///< automatic level: the coarsest whose cells project to <= this many importance px
+                                   ///< (4 and max_error_px 2: docs/isosurface.md, "The defaults")
   /// > 0 and a view: simplification also stops once its error would exceed this many importance pixels.
-  double max_error_px = 1.0;
+  double max_error_px = 2.0;
   /// Drop iso-surfaces that the TF hides from every direction (volume/iso_visibility.h), e.g. inside opaque
   /// material; if the probe finds none visible, all are kept.
   bool drop_hidden = true;
