@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -88,10 +89,14 @@ struct FullRender {
 };
 
 /// A frame of `o` whose importance is the saliency of the previous frame of this still view (the control at the
-/// same fraction); the saliency and its warp are part of the frame time.
+/// same fraction); the saliency and its warp are part of the frame time. The previous frame's depth is what a
+/// camera path keeps: the ray depth at its traced pixels (the full render's there), +inf elsewhere.
 Score saliency_frame(const volume::RayCaster& caster, const FullRender& full, const sampling::SamplingOptions& o) {
-  sampling::PreviousFrame previous{caster.camera().spec(), sampling::render_volume_frame(caster, nullptr, {}, o).image,
-                                   full.depth};
+  sampling::VolumeFrame control = sampling::render_volume_frame(caster, nullptr, {}, o);
+  ImageF depth = full.depth;
+  for (std::size_t i = 0; i < depth.size(); ++i)
+    if (!control.sampled.traced.pixels[i]) depth.pixels[i] = std::numeric_limits<float>::infinity();
+  sampling::PreviousFrame previous{caster.camera().spec(), std::move(control.image), std::move(depth)};
   sampling::PathFeatureOptions features;
   features.use_saliency = true;
   const Timer t;
@@ -209,7 +214,7 @@ void table1_and_fig7(const Scene3& s, const volume::RayCaster& caster, const iso
     std::printf("  %4.0fx (budget %6.1f ms): %6.1f ms, %5.1f%% rays, FLIP %.4f, 1-SSIM %.4f | vs subsample %.2f %.2f%s%s\n",
                 speedup, b.budget_ms, frame.total_ms,
                 100.0 * double(frame.sampled.rays_traced) / double(frame.sampled.full_rays), sc.flip, sc.dssim,
-                sc.flip / sub.flip, sc.dssim / sub.dssim, clamped ? "*" : "",
+                ratio(sc.flip, sub.flip), ratio(sc.dssim, sub.dssim), clamped ? "*" : "",
                 frame.sampled.budget_too_small ? " (budget_too_small)" : "");
     csv_row(csv, "fig7", s.name, "prioritized", speedup, clamped ? "budget_clamped" : "budget", ratio(sc.flip, sub.flip),
             ratio(sc.dssim, sub.dssim), ratio(sc.alpha, sub.alpha));

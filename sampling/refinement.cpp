@@ -102,10 +102,11 @@ class BucketQueue {
   std::size_t size_ = 0;
 };
 
-// Offsets from a pixel of `level` >= 1 to its parents, and (negated) from a parent to its children there.
+// Offsets from a pixel of `level` >= 1 to its parents, and (negated) from a parent to its children there; opposite
+// parents are adjacent (0-1, 2-3), as affine_residual() pairs them.
 std::array<std::array<int, 2>, 4> parent_offsets(int level, int spacing) {
   const int d = parent_offset(level, spacing);
-  if (level % 2 == 1) return {{{-d, -d}, {d, -d}, {-d, d}, {d, d}}};
+  if (level % 2 == 1) return {{{-d, -d}, {d, d}, {d, -d}, {-d, d}}};
   return {{{-d, 0}, {d, 0}, {0, -d}, {0, d}}};
 }
 
@@ -148,17 +149,13 @@ class CornerSpread {
   std::array<int, 4> lo_{255, 255, 255, 255}, hi_{0, 0, 0, 0};
 };
 
-// How far a cell's four parents are from an affine image, which every interpolation rule reproduces exactly (the
-// parents in parent_offsets() order: opposite pairs are 0-3 / 1-2 for a square's corners, 0-1 / 2-3 for an edge
-// midpoint's diamond): half the largest per-channel difference of the two pairs' sums, alpha weighted as in
-// CornerSpread, in [0, 1]. A smooth shading gradient has a large contrast but no residual; a curved edge, a
-// highlight or a texture has both. A straight edge parallel to a pair's axis is affine on the four parents; the
-// next level's cells, whose parents lie on both sides of it, see it. Ranking by it instead of the contrast met
-// more equal-time targets on every scene of the bench (docs/prioritized.md, session 14); the rounds' offers keep
-// the contrast, which measured better there.
-float affine_residual(const std::array<Percept, 4>& parents, int level, float alpha_weight) {
-  const bool square = level % 2 == 1;
-  const Percept &a = parents[0], &b = parents[square ? 3 : 1], &c = parents[square ? 1 : 2], &d = parents[square ? 2 : 3];
+// How far a cell's four parents (opposite ones adjacent, as parent_offsets() lists them) are from an affine image,
+// which every interpolation rule reproduces exactly: half the largest per-channel difference of the two pairs'
+// sums, alpha weighted as in CornerSpread, in [0, 1]. A smooth shading gradient has a large contrast but no
+// residual. A straight edge parallel to a pair's axis is affine on the four parents; the next level's cells, whose
+// parents lie on both sides of it, see it.
+float affine_residual(const std::array<Percept, 4>& parents, float alpha_weight) {
+  const Percept &a = parents[0], &b = parents[1], &c = parents[2], &d = parents[3];
   int colour = 0;
   for (int k = 0; k < 3; ++k) colour = std::max(colour, std::abs(int(a[k]) + int(b[k]) - int(c[k]) - int(d[k])));
   const int alpha = std::abs(int(a[3]) + int(b[3]) - int(c[3]) - int(d[3]));
@@ -600,7 +597,9 @@ std::vector<std::uint32_t> trace_first(const ImageF& importance, const FractalPa
 
 // Under a deadline, after the uniform levels: `pixels`, the object pixels of `level`, all of whose parents are
 // traced (the levels before it were traced whole) or background, ranked once by the affine residual of those
-// parents plus the line importance (the floor and level share of the refiner's priority are the same for all), and
+// parents plus the line importance (the floor and level share of the refiner's priority are the same for all; the
+// residual measured better than the refiner's contrast here, the contrast better in the rounds, docs/prioritized.md
+// session 14), and
 // traced in that order in slices of a quarter of what the time left holds, each in hashed tile order, until the
 // deadline. No rounds and no offers: every priority is known before the first ray (docs/prioritized.md, "Budget
 // mode without rounds"). \return the pixels traced; `rays_per_ms` ends as the rate of the last slice.
@@ -617,7 +616,7 @@ std::vector<std::uint32_t> trace_ranked_until(const std::vector<std::uint32_t>& 
     const std::uint32_t p = pixels[i];
     const int x = int(p % std::uint32_t(w)), y = int(p / std::uint32_t(w));
     // A background parent's image value, and percept, is 0. A cell cut by the image border has no affine test:
-    // the contrast of the parents inside stands in.
+    // half the contrast of the parents inside stands in (the residual of a step at one corner).
     std::array<Percept, 4> parents{};
     CornerSpread spread;
     bool inside = true;
@@ -630,7 +629,7 @@ std::vector<std::uint32_t> trace_ranked_until(const std::vector<std::uint32_t>& 
       parents[k] = percept_of(image(px, py));
       spread.add(parents[k]);
     }
-    const float error = inside ? affine_residual(parents, level, options.alpha_weight) : spread.contrast(options.alpha_weight);
+    const float error = inside ? affine_residual(parents, options.alpha_weight) : 0.5f * spread.contrast(options.alpha_weight);
     const float priority = std::min(3.9f, error + options.line_weight * importance.pixels[p]);
     const auto rank = std::uint32_t(0xFFFFFu - std::uint32_t(priority * float(1 << 18)));
     keys[i] = std::uint64_t(rank << 12 | (pixel_hash(p, seed) & 0xFFFu)) << 32 | p;

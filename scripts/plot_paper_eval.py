@@ -9,7 +9,7 @@ prioritized is better).
   separate alpha score), each against the ray fraction, one line per classifier, solid at equal frame time and
   dotted at equal rays. Hollow markers: the prioritized frame's time fell outside subsampling's measured curve.
 - Fig. 7: FLIP and 1 - SSIM at a guaranteed frame rate (budget mode at 2-16x the full render's rate), one line
-  per volume, against subsampling at the same frame time.
+  per volume, against subsampling at the same frame time (hollow markers: outside subsampling's curve).
 Debian's /usr/bin/python3 with python3-matplotlib.
 """
 import csv
@@ -78,7 +78,10 @@ def fig7(rows, out):
     for ax, (key, label) in zip(axes, METRICS[:2]):
         for scene in scenes:
             mine = [r for r in rows if r["scene"] == scene]
-            ax.plot([float(r["x"]) for r in mine], [float(r[key]) for r in mine], "o-", label=scene)
+            line, = ax.plot([float(r["x"]) for r in mine], [float(r[key]) for r in mine], "-", label=scene)
+            for r in mine:
+                ax.plot([float(r["x"])], [float(r[key])], "o", color=line.get_color(),
+                        markerfacecolor="none" if r["basis"].endswith("clamped") else line.get_color())
         ax.axhline(1.0, color="black", linewidth=0.8)
         ax.set_xscale("log", base=2)
         ax.set_xlabel("guaranteed frame rate, x the full render's")
