@@ -229,11 +229,9 @@ int main(int argc, char** argv) {
       for (const auto& res : {std::pair<int, int>{1440, 900}, std::pair<int, int>{960, 600}}) {
         run_view(c, vol, tf, fine, "default", res.first, res.second, features, rounds);
         run_view(c, vol, tf, coarse, "coarse", res.first, res.second, features, rounds);
-        // What `raysift render --mode prioritized` builds for this view: the level and the simplification bound
-        // chosen from the view and the importance scale.
-        sampling::FeatureGeometryOptions viewed;
-        viewed.view = isosurface::FeatureView{load_camera(c, res.first, res.second), scale};
-        run_view(c, vol, tf, sampling::build_feature_geometry(vol, tf, viewed), "view", res.first, res.second, features,
+        // What `raysift render --mode prioritized` builds for this view.
+        const isosurface::FeatureView view{load_camera(c, res.first, res.second), scale};
+        run_view(c, vol, tf, sampling::feature_geometry_for(vol, tf, view), "view", res.first, res.second, features,
                  rounds);
       }
     }

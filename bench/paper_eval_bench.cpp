@@ -7,8 +7,8 @@
 //  * Table 1: per-step frame times at 1440x900 (importance, priorities, trace, reconstruct) at 10 % of the rays.
 //  * Fig. 7: quality vs guaranteed frame rate: budget mode at 2, 4, 8 and 16 times the full render's rate.
 // The saliency classifier is the RP paper's image-space one: the saliency of the previous frame of the same still
-// view (the control frame at the same ray fraction, as the user saw it) warped to this frame, which for a still view
-// is the identity (the full render's depth places it); its time (saliency + warp) is charged to the frame.
+// view (the control frame at the same ray fraction, as the user saw it) warped to this frame with the depth a camera
+// path keeps (at the previous frame's traced pixels); its time (saliency + warp) is charged to the frame.
 // --csv FILE writes every ratio for scripts/plot_paper_eval.py, which draws docs/figures/paper_eval_fig5.png and
 // paper_eval_fig7.png.
 // Usage: paper_eval_bench [--quick] [--csv FILE]   (--quick: 720x450)
@@ -101,7 +101,8 @@ Score saliency_frame(const volume::RayCaster& caster, const FullRender& full, co
   features.use_saliency = true;
   const Timer t;
   const ImageF importance = sampling::path_frame_importance(caster, nullptr, features, &previous, o.base_spacing);
-  sampling::SampledFrame f = sampling::render_sampled(importance, sampling::caster_trace_batch(caster), o, t.elapsed_ms());
+  sampling::SampledFrame f =
+      sampling::render_sampled(importance, sampling::caster_trace_batch(caster), o, t.elapsed_ms());
   const ImageRGBA image = sampling::composite_frame(std::move(f.image), caster.options().background);
   return score(full.image, image, t.elapsed_ms(), full.object);
 }
@@ -109,7 +110,8 @@ Score saliency_frame(const volume::RayCaster& caster, const FullRender& full, co
 /// One plotted point: `basis` is equal_time or equal_rays (Fig. 5) or budget (Fig. 7, x = the speed-up).
 void csv_row(std::FILE* csv, const char* figure, const std::string& scene, const char* series, double x,
              const char* basis, double flip, double dssim, double alpha) {
-  if (csv) std::fprintf(csv, "%s,%s,%s,%g,%s,%.4f,%.4f,%.4f\n", figure, scene.c_str(), series, x, basis, flip, dssim, alpha);
+  if (csv)
+    std::fprintf(csv, "%s,%s,%s,%g,%s,%.4f,%.4f,%.4f\n", figure, scene.c_str(), series, x, basis, flip, dssim, alpha);
 }
 
 sampling::ImageMask object_mask(const ImageRGBA& full) {
@@ -216,8 +218,8 @@ void table1_and_fig7(const Scene3& s, const volume::RayCaster& caster, const iso
                 100.0 * double(frame.sampled.rays_traced) / double(frame.sampled.full_rays), sc.flip, sc.dssim,
                 ratio(sc.flip, sub.flip), ratio(sc.dssim, sub.dssim), clamped ? "*" : "",
                 frame.sampled.budget_too_small ? " (budget_too_small)" : "");
-    csv_row(csv, "fig7", s.name, "prioritized", speedup, clamped ? "budget_clamped" : "budget", ratio(sc.flip, sub.flip),
-            ratio(sc.dssim, sub.dssim), ratio(sc.alpha, sub.alpha));
+    csv_row(csv, "fig7", s.name, "prioritized", speedup, clamped ? "budget_clamped" : "budget",
+            ratio(sc.flip, sub.flip), ratio(sc.dssim, sub.dssim), ratio(sc.alpha, sub.alpha));
   }
 }
 
@@ -270,9 +272,8 @@ int main(int argc, char** argv) {
     const double full_ms = t.elapsed_ms();
     FullRender full{std::move(rendered.image), std::move(rendered.depth), {}};
     full.object = object_mask(full.image);
-    isosurface::FeatureGeometryOptions go;
-    go.view = isosurface::FeatureView{s.camera, features::ImportanceOptions{}.scale};
-    const isosurface::FeatureGeometry geometry = isosurface::build_feature_geometry(s.volume, s.tf, go);
+    const isosurface::FeatureGeometry geometry = sampling::feature_geometry_for(
+        s.volume, s.tf, isosurface::FeatureView{s.camera, features::ImportanceOptions{}.scale});
     const std::vector<Score> curve = subsample_curve(caster, full);
     fig5(s, caster, geometry, full, curve, csv);
     table1_and_fig7(s, caster, geometry, full, full_ms, curve, csv);

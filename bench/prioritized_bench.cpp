@@ -189,14 +189,6 @@ void write_orbit_csv(const std::string& path, const std::string& scene, const st
   }
 }
 
-// The feature geometry `raysift render --mode prioritized` builds for this view (level and simplification bound from
-// the view and the importance scale).
-sampling::FeatureGeometry view_geometry(const Scene& sc, const CameraSpec& cam, const sampling::FeatureOptions& features) {
-  sampling::FeatureGeometryOptions options;
-  options.view = isosurface::FeatureView{cam, features.importance.scale};
-  return sampling::build_feature_geometry(sc.vol, sc.tf, options);
-}
-
 // One scene's view with its full render and importance buffers; each table is one member function.
 struct SceneRun {
   const Setup& setup;
@@ -209,7 +201,12 @@ struct SceneRun {
   std::vector<TimedError> curve;  ///< subsampling's time->error curve
 
   SceneRun(const Scene& sc, const Setup& s, const CameraSpec& cam, const volume::RenderOptions& render)
-      : setup(s), scene(sc), caster(sc.vol, sc.tf, cam, render), geometry(view_geometry(sc, cam, s.features)) {
+      : setup(s),
+        scene(sc),
+        caster(sc.vol, sc.tf, cam, render),
+        // What `raysift render --mode prioritized` builds for this view.
+        geometry(sampling::feature_geometry_for(sc.vol, sc.tf,
+                                                isosurface::FeatureView{cam, s.features.importance.scale})) {
     full_ms = min_ms(2, [&] { full = volume::render_full(caster).image; });
     lines_ms = min_ms(2, [&] { lines = sampling::frame_importance(caster, &geometry, setup.features); });
     bg_ms = min_ms(2, [&] { background = sampling::frame_importance(caster, nullptr, {}); });

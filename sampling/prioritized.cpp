@@ -170,8 +170,9 @@ double estimate_reconstruct_ms(int width, int height, int base_spacing, Interpol
                                std::size_t object_pixels) {
   // Measured once per (crop, spacing, rule) and process: the estimate must not cost a reconstruction per frame.
   // Two per-pixel costs: an object pixel with only level 0 traced around it (the worst case), and a known pixel
-  // (background: only scanned). Each is the fastest of 3 runs: the first run pays for page faults on the fresh crop, which later frames do not (their
-  // buffers are reused), and a reserve sized by it wasted a third of a 15 ms budget.
+  // (background: only scanned). Each is the fastest of 3 runs: the first run pays for page faults on the fresh
+  // crop, which later frames do not (their buffers are reused), and a reserve sized by it wasted a third of a 15 ms
+  // budget.
   struct PixelCosts {
     double object_ms, known_ms;
   };

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <array>
-#include <cstdlib>
 #include <cmath>
+#include <cstdlib>
 #include <vector>
 
 #include "core/errors.h"
@@ -599,10 +599,10 @@ std::vector<std::uint32_t> trace_first(const ImageF& importance, const FractalPa
 // traced (the levels before it were traced whole) or background, ranked once by the affine residual of those
 // parents plus the line importance (the floor and level share of the refiner's priority are the same for all; the
 // residual measured better than the refiner's contrast here, the contrast better in the rounds, docs/prioritized.md
-// session 14), and
-// traced in that order in slices of a quarter of what the time left holds, each in hashed tile order, until the
-// deadline. No rounds and no offers: every priority is known before the first ray (docs/prioritized.md, "Budget
-// mode without rounds"). \return the pixels traced; `rays_per_ms` ends as the rate of the last slice.
+// session 14), and traced in that order in slices of a quarter of what the time left holds, each in hashed tile
+// order, until the deadline. No rounds and no offers: every priority is known before the first ray
+// (docs/prioritized.md, "Budget mode without rounds"). \return the pixels traced; `rays_per_ms` ends as the rate of
+// the last slice.
 std::vector<std::uint32_t> trace_ranked_until(const std::vector<std::uint32_t>& pixels, int level,
                                               const ImageF& importance, const FractalPattern& pattern,
                                               const RefinementOptions& options, const RefinementStop& stop,
@@ -629,7 +629,8 @@ std::vector<std::uint32_t> trace_ranked_until(const std::vector<std::uint32_t>& 
       parents[k] = percept_of(image(px, py));
       spread.add(parents[k]);
     }
-    const float error = inside ? affine_residual(parents, options.alpha_weight) : 0.5f * spread.contrast(options.alpha_weight);
+    const float error =
+        inside ? affine_residual(parents, options.alpha_weight) : 0.5f * spread.contrast(options.alpha_weight);
     const float priority = std::min(3.9f, error + options.line_weight * importance.pixels[p]);
     const auto rank = std::uint32_t(0xFFFFFu - std::uint32_t(priority * float(1 << 18)));
     keys[i] = std::uint64_t(rank << 12 | (pixel_hash(p, seed) & 0xFFFu)) << 32 | p;

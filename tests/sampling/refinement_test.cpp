@@ -142,9 +142,9 @@ TEST(Refinement, UniformLevelsAreTracedWholeAndTheRestGoesToTheEdge) {
   EXPECT_GT(near / near_n, 2 * far / far_n) << "the rays beyond the uniform lattice must go to the edge";
 }
 
-// Under a deadline the level after the uniform ones is ranked once by its parents' affine residual: 12 virtual ms at 10 us
-// a ray hold levels 0-3 (864 rays) and part of level 4 (864 pixels), and every level-4 pixel whose parents straddle
-// the edge comes before any whose parents agree.
+// Under a deadline the level after the uniform ones is ranked once by its parents' affine residual: 12 virtual ms at
+// 10 us a ray hold levels 0-3 (864 rays) and part of level 4 (864 pixels), and every level-4 pixel whose parents
+// straddle the edge comes before any whose parents agree.
 TEST(Refinement, UnderADeadlineTheNextLevelTracesTheStepEdgeFirst) {
   StepEdgeRun edge;
   std::atomic<std::int64_t> clock_us{0};
@@ -335,7 +335,8 @@ TEST(Refinement, UnderADeadlineTheRankedLevelTracesCurvedEdgesBeforeASteepRamp) 
       level3 += traced(x, y);
       if (x + 2 >= kW || y + 2 >= kH) continue;
       // A rim cell that is not affine on its corners: an odd number of them inside the disc.
-      const int corners_inside = inside(x - 2, y - 2) + inside(x + 2, y - 2) + inside(x - 2, y + 2) + inside(x + 2, y + 2);
+      const int corners_inside =
+          inside(x - 2, y - 2) + inside(x + 2, y - 2) + inside(x - 2, y + 2) + inside(x + 2, y + 2);
       if (corners_inside % 2 == 0) continue;
       ++rim;
       EXPECT_TRUE(traced(x, y)) << "rim cell centre " << x << "," << y << " left for the ramp";
